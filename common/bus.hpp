@@ -1,0 +1,124 @@
+#pragma once
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace sg {
+
+/// The bus could not be opened or used; the message is one line that names the URL.
+class BusError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// What arrived with a message, besides its contents.
+struct ReceiveInfo {
+  std::string channel;
+  int64_t recv_utime = 0;  ///< when LCM received it (microseconds since the Unix epoch)
+  int32_t size = 0;        ///< encoded size in bytes
+};
+
+/// A raw, undecoded message (for loggers and tools that handle any type).
+struct RawMessage {
+  ReceiveInfo info;
+  const uint8_t* data = nullptr;
+};
+
+/// The LCM bus every process talks through: typed publish and subscribe over `lcm::LCM`, with
+/// clear errors where LCM itself only prints or returns a code.
+///
+///     sg::Bus bus(options.lcm_url);                       // "" = LCM's default (LCM_DEFAULT_URL)
+///     bus.subscribe<stereograsp::point3_t>("OBJECT_POSITION",
+///         [&](const stereograsp::point3_t& p, const sg::ReceiveInfo&) { predictor.add(p); });
+///     bus.publish("OBJECT_TRAJECTORY", trajectory);
+///     bus.spin();                                         // until SIGINT or SIGTERM
+///
+/// A message that does not decode as the subscribed type (another type on the channel, a wrong
+/// size, trailing bytes) is counted in decode_errors() and logged with its channel and size; the
+/// handler is not called.
+class Bus {
+ public:
+  /// Opens the bus; throws BusError when LCM cannot use `url` (unknown provider, bad address,
+  /// no multicast route, invalid option), with LCM's own complaint folded into one line.
+  explicit Bus(const std::string& url = "");
+  ~Bus();
+  Bus(const Bus&) = delete;
+  Bus& operator=(const Bus&) = delete;
+
+  /// The URL as given ("" for LCM's default).
+  const std::string& url() const { return url_; }
+
+  /// Encodes and publishes; returns false (and logs, and counts) when LCM could not send.
+  template <class Message>
+  bool publish(const std::string& channel, const Message& message) {
+    const int size = message.getEncodedSize();
+    buffer_.resize(static_cast<size_t>(size));
+    if (message.encode(buffer_.data(), 0, size) != size) {
+      throw BusError("cannot encode " + std::string(Message::getTypeName()) + " for channel " +
+                     channel);
+    }
+    return publish_raw(channel, buffer_.data(), size);
+  }
+
+  /// Publishes bytes as they are (tools and tests).
+  bool publish_raw(const std::string& channel, const void* data, int size);
+
+  /// Calls `handler` with each message on channels matching `channel_regex` that decodes as
+  /// Message, exactly and completely.
+  template <class Message>
+  void subscribe(const std::string& channel_regex,
+                 std::function<void(const Message&, const ReceiveInfo&)> handler) {
+    subscribe_raw(channel_regex, [this, handler = std::move(handler)](const RawMessage& raw) {
+      Message message{};
+      if (message.decode(raw.data, 0, raw.info.size) != raw.info.size) {
+        report_decode_error(raw.info, Message::getTypeName());
+        return;
+      }
+      handler(message, raw.info);
+    });
+  }
+
+  /// Calls `handler` with every message on matching channels, undecoded.
+  void subscribe_raw(const std::string& channel_regex,
+                     std::function<void(const RawMessage&)> handler);
+
+  /// Waits up to `timeout` for one message and dispatches it. Returns true when a message was
+  /// handled, false on time-out (or an interrupting signal); throws BusError when LCM fails,
+  /// and, on a `file://` URL, returns false at the end of the log (see end_of_log()).
+  bool handle(std::chrono::milliseconds timeout);
+
+  /// Dispatches messages until shutdown is requested (SIGINT, SIGTERM) or `keep_going` returns
+  /// false; checks both at least every `poll`.
+  void spin(const std::function<bool()>& keep_going = [] { return true; },
+            std::chrono::milliseconds poll = std::chrono::milliseconds(100));
+
+  /// True once a `file://` bus has reached the end of its log.
+  bool end_of_log() const { return end_of_log_; }
+
+  uint64_t decode_errors() const { return decode_errors_; }
+  uint64_t publish_errors() const { return publish_errors_; }
+
+  /// The underlying LCM object, for what this wrapper does not cover.
+  lcm::LCM& lcm() { return *lcm_; }
+
+ private:
+  class RawHandler;
+  void report_decode_error(const ReceiveInfo& info, const char* type_name);
+
+  std::string url_;
+  std::unique_ptr<lcm::LCM> lcm_;
+  std::vector<std::unique_ptr<RawHandler>> handlers_;
+  std::vector<uint8_t> buffer_;
+  uint64_t decode_errors_ = 0;
+  uint64_t publish_errors_ = 0;
+  bool end_of_log_ = false;
+};
+
+}  // namespace sg

@@ -1,0 +1,220 @@
+// sg-bus-check: is the LCM bus between these processes (or these lab machines) sound?
+//
+//   machine A:  sg-bus-check receive --count 1000 --lcm-url 'udpm://239.255.76.67:7667?ttl=1'
+//   machine B:  sg-bus-check send    --count 1000 --lcm-url 'udpm://239.255.76.67:7667?ttl=1'
+//
+// `send` publishes one message of every stereograsp type in turn on BUS_CHECK_<TYPE>, each with
+// contents derived from its utime; `receive` checks every byte and reports loss, corruption and
+// latency; `verify-log` checks a log that lcm-logger recorded of such a stream.
+
+#include <lcm/lcm-cpp.hpp>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <set>
+#include <thread>
+#include <vector>
+
+#include "common/bus.hpp"
+#include "common/bus_check.hpp"
+#include "common/clock.hpp"
+#include "common/program.hpp"
+#include "common/shutdown.hpp"
+
+namespace {
+
+using namespace std::chrono;
+
+struct SendOptions {
+  int64_t count = 1000;
+  double rate_hz = 100.0;
+  double duration_s = 0.0;
+};
+
+struct ReceiveOptions {
+  int64_t count = 0;
+  double timeout_s = 30.0;
+};
+
+/// Tallies checked messages: per channel, corrupt, duplicates, latency.
+class Tally {
+ public:
+  void add(const std::string& channel_name, const uint8_t* data, int size, int64_t recv_utime) {
+    const auto verdict = sg::bus_check::verify(channel_name, data, size);
+    if (!verdict) {
+      ++other_;
+      return;
+    }
+    ++per_channel_[channel_name];
+    if (!verdict->intact) {
+      ++corrupt_;
+      spdlog::warn("{}: a {}-byte message differs from what was sent", channel_name, size);
+      return;
+    }
+    if (!seen_.insert(verdict->utime).second) ++duplicates_;
+    if (recv_utime > 0) latencies_us_.push_back(recv_utime - verdict->utime);
+  }
+
+  int64_t intact() const { return static_cast<int64_t>(seen_.size()); }
+  int64_t corrupt() const { return corrupt_; }
+  int64_t duplicates() const { return duplicates_; }
+
+  /// One summary line; `expected` 0 means no expectation.
+  std::string summary(int64_t expected, double seconds) const {
+    std::string line = "received " + std::to_string(intact());
+    if (expected > 0) {
+      line += " of " + std::to_string(expected) + " (" +
+              std::to_string(std::max<int64_t>(0, expected - intact())) + " lost)";
+    }
+    char tail[256];
+    std::snprintf(tail, sizeof tail, " on %zu channels in %.2f s; %lld corrupt, %lld duplicate",
+                  per_channel_.size(), seconds, static_cast<long long>(corrupt_),
+                  static_cast<long long>(duplicates_));
+    line += tail;
+    if (other_ > 0) line += ", " + std::to_string(other_) + " on other channels";
+    if (!latencies_us_.empty()) {
+      std::vector<int64_t> sorted = latencies_us_;
+      std::sort(sorted.begin(), sorted.end());
+      auto at = [&](double q) {
+        return sorted[static_cast<size_t>(q * static_cast<double>(sorted.size() - 1))] / 1000.0;
+      };
+      std::snprintf(tail, sizeof tail, "; latency p50 %.3f ms, p99 %.3f ms, max %.3f ms", at(0.5),
+                    at(0.99), sorted.back() / 1000.0);
+      line += tail;
+    }
+    return line;
+  }
+
+  std::string per_channel() const {
+    std::string text;
+    for (const auto& [name, n] : per_channel_) text += "  " + name + ": " + std::to_string(n) + "\n";
+    return text;
+  }
+
+ private:
+  std::map<std::string, int64_t> per_channel_;
+  std::set<int64_t> seen_;
+  std::vector<int64_t> latencies_us_;
+  int64_t corrupt_ = 0;
+  int64_t duplicates_ = 0;
+  int64_t other_ = 0;
+};
+
+int run_send(sg::Bus& bus, const SendOptions& options) {
+  const auto start = steady_clock::now();
+  const auto period = duration<double>(1.0 / options.rate_hz);
+  int64_t last_utime = 0;
+  int64_t sent = 0;
+  for (; options.count == 0 || sent < options.count; ++sent) {
+    if (sg::shutdown_requested()) break;
+    if (options.duration_s > 0 && steady_clock::now() - start >= duration<double>(options.duration_s))
+      break;
+    const int type_index = static_cast<int>(sent % sg::bus_check::type_count());
+    last_utime = std::max(sg::now_utime(), last_utime + 1);  // unique, increasing
+    const std::vector<uint8_t> bytes = sg::bus_check::encode(type_index, last_utime);
+    bus.publish_raw(sg::bus_check::channel(type_index), bytes.data(),
+                    static_cast<int>(bytes.size()));
+    std::this_thread::sleep_until(start + duration_cast<steady_clock::duration>(period * (sent + 1)));
+  }
+  const double seconds = duration<double>(steady_clock::now() - start).count();
+  std::printf("sent %lld messages of %d types in %.2f s (%lld publish errors)\n",
+              static_cast<long long>(sent), sg::bus_check::type_count(), seconds,
+              static_cast<long long>(bus.publish_errors()));
+  return bus.publish_errors() == 0 ? 0 : 1;
+}
+
+int run_receive(sg::Bus& bus, const ReceiveOptions& options) {
+  Tally tally;
+  bus.subscribe_raw(std::string(sg::bus_check::kChannelPrefix) + ".*",
+                    [&](const sg::RawMessage& raw) {
+                      tally.add(raw.info.channel, raw.data, raw.info.size, raw.info.recv_utime);
+                    });
+  const auto start = steady_clock::now();
+  auto last_arrival = start;
+  int64_t handled = 0;
+  bus.spin([&] {
+    if (tally.intact() + tally.corrupt() > handled) {
+      handled = tally.intact() + tally.corrupt();
+      last_arrival = steady_clock::now();
+    }
+    if (options.count > 0 && tally.intact() >= options.count) return false;
+    // Time out only on silence, so a long stream is not cut short.
+    return options.timeout_s <= 0 ||
+           steady_clock::now() - last_arrival < duration<double>(options.timeout_s);
+  });
+  const double seconds = duration<double>(steady_clock::now() - start).count();
+  std::printf("%s\n", tally.summary(options.count, seconds).c_str());
+  const bool complete = options.count == 0 || tally.intact() >= options.count;
+  return complete && tally.corrupt() == 0 && tally.duplicates() == 0 ? 0 : 1;
+}
+
+int run_verify_log(const std::string& path, int64_t expected) {
+  lcm::LogFile log(path, "r");
+  if (!log.good()) throw std::runtime_error(path + ": cannot open as an LCM log");
+  Tally tally;
+  int64_t events = 0;
+  while (const lcm::LogEvent* event = log.readNextEvent()) {
+    ++events;
+    tally.add(event->channel, static_cast<const uint8_t*>(event->data), event->datalen, 0);
+  }
+  std::printf("%s: %lld events\n%s%s\n", path.c_str(), static_cast<long long>(events),
+              tally.per_channel().c_str(), tally.summary(expected, 0.0).c_str());
+  const bool complete = expected == 0 || tally.intact() == expected;
+  return complete && tally.corrupt() == 0 && tally.duplicates() == 0 ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Checks an LCM bus end to end with every stereograsp message type.", "sg-bus-check"};
+  app.require_subcommand(1);
+  sg::CommonOptions common;
+  sg::add_common_options(app, common);
+
+  SendOptions send;
+  CLI::App* send_cmd = app.add_subcommand("send", "Publish check messages on BUS_CHECK_<TYPE>");
+  CLI::Option* send_count = send_cmd->add_option("--count", send.count,
+                                                 "messages to send, 0 for no limit (default 1000, "
+                                                 "config bus_check.count)");
+  CLI::Option* send_rate =
+      send_cmd->add_option("--rate", send.rate_hz, "messages per second (default 100, config "
+                                                   "bus_check.rate_hz)");
+  send_cmd->add_option("--duration", send.duration_s, "stop after this many seconds (0: no limit)")
+      ->check(CLI::NonNegativeNumber);
+
+  ReceiveOptions receive;
+  CLI::App* receive_cmd =
+      app.add_subcommand("receive", "Check messages arriving on BUS_CHECK_<TYPE>; exit 1 on loss");
+  receive_cmd->add_option("--count", receive.count,
+                          "messages to wait for, 0 to run until interrupted");
+  receive_cmd->add_option("--timeout", receive.timeout_s,
+                          "give up after this many seconds without a message (0: never)");
+
+  std::string log_path;
+  int64_t log_count = 0;
+  CLI::App* verify_cmd =
+      app.add_subcommand("verify-log", "Check a log that lcm-logger recorded of a send");
+  verify_cmd->add_option("LOG", log_path, "the LCM log file")->required();
+  verify_cmd->add_option("--count", log_count, "messages the log must hold intact (0: any)");
+
+  return sg::run_program(app, argc, argv, [&] {
+    const sg::Config config = sg::load_common(common);
+    if (*verify_cmd) return run_verify_log(log_path, log_count);
+
+    if (!*send_count) send.count = config.get<int64_t>("bus_check.count", send.count);
+    if (!*send_rate) send.rate_hz = config.get<double>("bus_check.rate_hz", send.rate_hz);
+    if (!std::isfinite(send.rate_hz) || send.rate_hz <= 0) {
+      if (*send_rate) throw std::runtime_error("--rate must be a positive number");
+      throw config.error_at("bus_check.rate_hz", "must be a positive number");
+    }
+    if (send.count < 0) throw config.error_at("bus_check.count", "must not be negative");
+
+    sg::install_shutdown_handlers();
+    sg::Bus bus(common.lcm_url);
+    return *send_cmd ? run_send(bus, send) : run_receive(bus, receive);
+  });
+}
