@@ -1,0 +1,139 @@
+// The bus wrapper: typed publish/subscribe, refusal of undecodable messages, clear URL errors.
+
+#include "common/bus.hpp"
+
+#include <gtest/gtest.h>
+
+#include "common/message_types.hpp"
+#include "common/shutdown.hpp"
+
+namespace sg {
+namespace {
+
+using namespace std::chrono_literals;
+using stereograsp::blob_t;
+using stereograsp::point3_t;
+
+point3_t make_point(int64_t utime, double x) {
+  point3_t p{};
+  p.utime = utime;
+  p.visible = 1;
+  p.position[0] = x;
+  return p;
+}
+
+// A typed subscriber receives exactly what was published, with its channel and size.
+TEST(Bus, TypedPublishSubscribeOverMemq) {
+  Bus bus("memq://");
+  std::vector<point3_t> received;
+  std::vector<ReceiveInfo> infos;
+  bus.subscribe<point3_t>("OBJECT_POSITION", [&](const point3_t& p, const ReceiveInfo& info) {
+    received.push_back(p);
+    infos.push_back(info);
+  });
+  ASSERT_TRUE(bus.publish("OBJECT_POSITION", make_point(1000, 0.25)));
+  ASSERT_TRUE(bus.publish("OBJECT_POSITION", make_point(2000, -0.5)));
+  EXPECT_TRUE(bus.handle(100ms));
+  EXPECT_TRUE(bus.handle(100ms));
+  EXPECT_FALSE(bus.handle(10ms)) << "nothing more to handle";
+  ASSERT_EQ(received.size(), 2u);
+  EXPECT_EQ(received[0].utime, 1000);
+  EXPECT_DOUBLE_EQ(received[1].position[0], -0.5);
+  EXPECT_EQ(infos[0].channel, "OBJECT_POSITION");
+  EXPECT_EQ(infos[0].size, make_point(0, 0).getEncodedSize());
+  EXPECT_GT(infos[0].recv_utime, 0);
+}
+
+// Channel patterns are regular expressions, as in LCM.
+TEST(Bus, SubscribesByRegex) {
+  Bus bus("memq://");
+  std::vector<std::string> channels;
+  bus.subscribe<blob_t>("BLOB_.*", [&](const blob_t&, const ReceiveInfo& info) {
+    channels.push_back(info.channel);
+  });
+  blob_t blob{};
+  bus.publish("BLOB_LEFT", blob);
+  bus.publish("BLOB_RIGHT", blob);
+  bus.publish("OBJECT_POSITION", make_point(1, 1));
+  while (bus.handle(10ms)) {
+  }
+  EXPECT_EQ(channels, (std::vector<std::string>{"BLOB_LEFT", "BLOB_RIGHT"}));
+}
+
+// Another type, a truncated message and trailing bytes are counted and dropped, never handed on.
+TEST(Bus, UndecodableMessagesAreCountedAndDropped) {
+  Bus bus("memq://");
+  int calls = 0;
+  bus.subscribe<point3_t>("OBJECT_POSITION", [&](const point3_t&, const ReceiveInfo&) { ++calls; });
+
+  bus.publish("OBJECT_POSITION", blob_t{});  // wrong type
+  std::vector<uint8_t> bytes(static_cast<size_t>(make_point(5, 1).getEncodedSize()));
+  make_point(5, 1).encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  bus.publish_raw("OBJECT_POSITION", bytes.data(), static_cast<int>(bytes.size()) - 3);  // short
+  bytes.push_back(0);
+  bus.publish_raw("OBJECT_POSITION", bytes.data(), static_cast<int>(bytes.size()));  // long
+  bytes.pop_back();
+  bus.publish_raw("OBJECT_POSITION", bytes.data(), static_cast<int>(bytes.size()));  // good
+  while (bus.handle(10ms)) {
+  }
+  EXPECT_EQ(bus.decode_errors(), 3u);
+  EXPECT_EQ(calls, 1);
+}
+
+// Unusable URLs throw one line that names the URL and LCM's reason.
+TEST(Bus, BadUrlsThrowOneClearLine) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"bogus://x", "provider \"bogus\" not found"},
+      {"udpm://300.1.1.1:7667", "Bad multicast IP address"},
+      {"udpm://239.255.76.67:99999", "Bad multicast port"},
+      {"file:///nonexistent/dir/x.log?mode=r", "No such file"},
+      {"udpm://239.255.76.67:7667?ttl=abc", "Invalid value for ttl"},
+      {"garbage", "invalid URL"},
+  };
+  for (const auto& [url, reason] : cases) {
+    try {
+      Bus bus(url);
+      ADD_FAILURE() << url << " was accepted";
+    } catch (const BusError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(url), std::string::npos) << what;
+      EXPECT_NE(what.find(reason), std::string::npos) << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+  }
+}
+
+// spin() returns when the predicate says so, and when shutdown is requested.
+TEST(Bus, SpinStopsOnPredicateAndOnShutdown) {
+  Bus bus("memq://");
+  int handled = 0;
+  bus.subscribe<point3_t>("P", [&](const point3_t&, const ReceiveInfo&) { ++handled; });
+  for (int i = 0; i < 5; ++i) bus.publish("P", make_point(i, 0));
+  bus.spin([&] { return handled < 3; }, 10ms);
+  EXPECT_EQ(handled, 3);
+  request_shutdown();
+  bus.spin([] { return true; }, 10ms);  // returns at once
+  reset_shutdown();
+  EXPECT_EQ(handled, 3);
+}
+
+// A file:// bus reads a log and reports its end.
+TEST(Bus, FileUrlReportsEndOfLog) {
+  const std::string path = "/tmp/sg-bus-test-" + std::to_string(getpid()) + ".lcmlog";
+  {
+    Bus writer("file://" + path + "?mode=w");
+    writer.publish("OBJECT_POSITION", make_point(42, 1.0));
+    writer.publish("OBJECT_POSITION", make_point(43, 2.0));
+  }
+  Bus reader("file://" + path + "?mode=r&speed=0");
+  std::vector<int64_t> utimes;
+  reader.subscribe<point3_t>("OBJECT_POSITION",
+                             [&](const point3_t& p, const ReceiveInfo&) { utimes.push_back(p.utime); });
+  reader.spin([] { return true; }, 100ms);
+  EXPECT_TRUE(reader.end_of_log());
+  EXPECT_EQ(utimes, (std::vector<int64_t>{42, 43}));
+  std::remove(path.c_str());
+}
+
+}  // namespace
+}  // namespace sg
