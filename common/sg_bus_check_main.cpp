@@ -46,7 +46,7 @@ class Tally {
   void add(const std::string& channel_name, const uint8_t* data, int size, int64_t recv_utime) {
     const auto verdict = sg::bus_check::verify(channel_name, data, size);
     if (!verdict) {
-      ++other_;
+      ++other_[channel_name];  // e.g. LCM_SELF_TEST, which LCM's udpm sends when a bus opens
       return;
     }
     ++per_channel_[channel_name];
@@ -63,19 +63,24 @@ class Tally {
   int64_t corrupt() const { return corrupt_; }
   int64_t duplicates() const { return duplicates_; }
 
-  /// One summary line; `expected` 0 means no expectation.
+  /// One summary line; `expected` 0 means no expectation; `seconds` < 0 for a log.
   std::string summary(int64_t expected, double seconds) const {
-    std::string line = "received " + std::to_string(intact());
+    std::string line = (seconds < 0 ? "intact " : "received ") + std::to_string(intact());
     if (expected > 0) {
       line += " of " + std::to_string(expected) + " (" +
               std::to_string(std::max<int64_t>(0, expected - intact())) + " lost)";
     }
     char tail[256];
-    std::snprintf(tail, sizeof tail, " on %zu channels in %.2f s; %lld corrupt, %lld duplicate",
-                  per_channel_.size(), seconds, static_cast<long long>(corrupt_),
-                  static_cast<long long>(duplicates_));
+    std::snprintf(tail, sizeof tail, " on %zu channels", per_channel_.size());
     line += tail;
-    if (other_ > 0) line += ", " + std::to_string(other_) + " on other channels";
+    if (seconds >= 0) {
+      std::snprintf(tail, sizeof tail, " in %.2f s", seconds);
+      line += tail;
+    }
+    std::snprintf(tail, sizeof tail, "; %lld corrupt, %lld duplicate",
+                  static_cast<long long>(corrupt_), static_cast<long long>(duplicates_));
+    line += tail;
+    for (const auto& [name, n] : other_) line += ", " + std::to_string(n) + " on " + name;
     if (!latencies_us_.empty()) {
       std::vector<int64_t> sorted = latencies_us_;
       std::sort(sorted.begin(), sorted.end());
@@ -101,7 +106,7 @@ class Tally {
   std::vector<int64_t> latencies_us_;
   int64_t corrupt_ = 0;
   int64_t duplicates_ = 0;
-  int64_t other_ = 0;
+  std::map<std::string, int64_t> other_;
 };
 
 int run_send(sg::Bus& bus, const SendOptions& options) {
@@ -162,7 +167,7 @@ int run_verify_log(const std::string& path, int64_t expected) {
     tally.add(event->channel, static_cast<const uint8_t*>(event->data), event->datalen, 0);
   }
   std::printf("%s: %lld events\n%s%s\n", path.c_str(), static_cast<long long>(events),
-              tally.per_channel().c_str(), tally.summary(expected, 0.0).c_str());
+              tally.per_channel().c_str(), tally.summary(expected, -1.0).c_str());
   const bool complete = expected == 0 || tally.intact() == expected;
   return complete && tally.corrupt() == 0 && tally.duplicates() == 0 ? 0 : 1;
 }

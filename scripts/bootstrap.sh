@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# Installs every Debian package stereograsp needs (only those missing), then configures and
+# builds. Safe to run again and again.
+#
+#   scripts/bootstrap.sh                 install what is missing, build into build/
+#   scripts/bootstrap.sh --no-build      install only
+#   scripts/bootstrap.sh --build-dir DIR build elsewhere
+#   scripts/bootstrap.sh --debug         Debug build instead of Release
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+build=1
+build_dir=build
+build_type=Release
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --no-build) build=0 ;;
+    --build-dir) build_dir="$2"; shift ;;
+    --debug) build_type=Debug ;;
+    -h|--help) sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "bootstrap.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
+  esac
+  shift
+done
+
+# Why each package is here: docs/architecture.md, "Dependencies".
+packages=(
+  cmake g++ make                                   # the build
+  liblcm-dev liblcm-bin liblcm-java               # LCM: library, lcm-gen/logger/logplayer, lcm.jar
+  default-jdk-headless default-jre libjchart2d-java  # the types jar, lcm-spy and its charts
+  libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev  # config, flags, logging
+  libeigen3-dev                                    # linear algebra
+  libgtest-dev libgmock-dev libbenchmark-dev       # tests and benchmarks
+  iproute2 util-linux                              # ip and unshare for scripts/multicast.sh
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "bootstrap: installing ${missing[*]}"
+  if [ "$(id -u)" -eq 0 ]; then
+    sudo=()
+  elif command -v sudo >/dev/null; then
+    sudo=(sudo)
+  else
+    echo "bootstrap: need root (or sudo) to install: ${missing[*]}" >&2
+    exit 1
+  fi
+  export DEBIAN_FRONTEND=noninteractive
+  "${sudo[@]}" apt-get update -qq
+  "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  echo "bootstrap: packages installed"
+fi
+
+[ "$build" -eq 1 ] || exit 0
+
+cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE="$build_type" >/dev/null
+cmake --build "$build_dir" -j "$(nproc)"
+echo "bootstrap: built into $build_dir/ (programs in $build_dir/bin)"
