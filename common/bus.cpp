@@ -5,6 +5,7 @@
 
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 
 #include "common/shutdown.hpp"
@@ -60,6 +61,20 @@ std::string one_line(const std::string& text) {
   return line;
 }
 
+/// The URL as the user knows it: as given, or where LCM's default came from.
+std::string describe_url(const std::string& url) {
+  std::string shown;
+  const char* env = std::getenv("LCM_DEFAULT_URL");
+  if (!url.empty()) {
+    shown.append("'").append(url).append("'");
+  } else if (env != nullptr) {
+    shown.append("'").append(env).append("' (LCM_DEFAULT_URL)");
+  } else {
+    shown = "(LCM's default)";
+  }
+  return shown;
+}
+
 }  // namespace
 
 class Bus::RawHandler {
@@ -79,9 +94,8 @@ class Bus::RawHandler {
 };
 
 Bus::Bus(const std::string& url) : url_(url) {
-  const std::string complaint =
-      capture_stderr([&] { lcm_ = std::make_unique<lcm::LCM>(url_); });
-  const std::string shown = url_.empty() ? "(LCM default)" : "'" + url_ + "'";
+  const std::string complaint = capture_stderr([&] { lcm_ = std::make_unique<lcm::LCM>(url_); });
+  const std::string shown = describe_url(url_);
   if (!lcm_->good()) {
     throw BusError("cannot open LCM URL " + shown + ": " +
                    (complaint.empty() ? "LCM refused it" : one_line(complaint)));

@@ -1,10 +1,9 @@
 #pragma once
 
-#include <lcm/lcm-cpp.hpp>
-
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <lcm/lcm-cpp.hpp>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -96,8 +95,9 @@ class Bus {
 
   /// Dispatches messages until shutdown is requested (SIGINT, SIGTERM) or `keep_going` returns
   /// false; checks both at least every `poll`.
-  void spin(const std::function<bool()>& keep_going = [] { return true; },
-            std::chrono::milliseconds poll = std::chrono::milliseconds(100));
+  void spin(
+      const std::function<bool()>& keep_going = [] { return true; },
+      std::chrono::milliseconds poll = std::chrono::milliseconds(100));
 
   /// True once a `file://` bus has reached the end of its log.
   bool end_of_log() const { return end_of_log_; }

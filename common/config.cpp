@@ -47,8 +47,8 @@ YAML::Node Config::find(const std::string& key) const {
   std::string walked;
   for (const std::string& part : split_key(key)) {
     if (!current.IsMap()) {
-      throw ConfigError(where(current) + ": key '" + walked + "' must be a map to hold '" +
-                        key + "'");
+      throw ConfigError(where(current) + ": key '" + walked + "' must be a map to hold '" + key +
+                        "'");
     }
     const YAML::Node child = std::as_const(current)[part];
     if (!child) return YAML::Node(YAML::NodeType::Undefined);
@@ -71,11 +71,16 @@ std::string Config::where(const YAML::Node& node) const {
 
 std::string Config::describe(const YAML::Node& node) {
   switch (node.Type()) {
-    case YAML::NodeType::Scalar: return "'" + node.Scalar() + "'";
-    case YAML::NodeType::Sequence: return "a list";
-    case YAML::NodeType::Map: return "a map";
-    case YAML::NodeType::Null: return "nothing";
-    default: return "an undefined value";
+    case YAML::NodeType::Scalar:
+      return "'" + node.Scalar() + "'";
+    case YAML::NodeType::Sequence:
+      return "a list";
+    case YAML::NodeType::Map:
+      return "a map";
+    case YAML::NodeType::Null:
+      return "nothing";
+    default:
+      return "an undefined value";
   }
 }
 

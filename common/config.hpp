@@ -70,11 +70,16 @@ class Config {
   static std::string describe(const YAML::Node& node);
   template <class T>
   static constexpr const char* type_name() {
-    if constexpr (std::is_same_v<T, bool>) return "true or false";
-    else if constexpr (std::is_integral_v<T>) return "an integer";
-    else if constexpr (std::is_floating_point_v<T>) return "a number";
-    else if constexpr (std::is_same_v<T, std::string>) return "a string";
-    else return "a list or map of the right kind";
+    if constexpr (std::is_same_v<T, bool>)
+      return "true or false";
+    else if constexpr (std::is_integral_v<T>)
+      return "an integer";
+    else if constexpr (std::is_floating_point_v<T>)
+      return "a number";
+    else if constexpr (std::is_same_v<T, std::string>)
+      return "a string";
+    else
+      return "a list or map of the right kind";
   }
 
   template <class T>
@@ -82,8 +87,8 @@ class Config {
     try {
       return node.as<T>();
     } catch (const YAML::Exception&) {
-      throw ConfigError(where(node) + ": key '" + key + "': expected " + type_name<T>() +
-                        ", got " + describe(node));
+      throw ConfigError(where(node) + ": key '" + key + "': expected " + type_name<T>() + ", got " +
+                        describe(node));
     }
   }
 

@@ -16,17 +16,17 @@ namespace sg {
 
 /// Every stereograsp message type, for code that handles all of them alike (bus checks, log
 /// readers, tests). Add a type here when adding a .lcm file.
-using MessageTypes =
-    std::tuple<stereograsp::image_t, stereograsp::blob_t, stereograsp::point3_t,
-               stereograsp::trajectory_t, stereograsp::arm_cmd_t, stereograsp::arm_status_t,
-               stereograsp::grasp_command_t, stereograsp::grasp_status_t,
-               stereograsp::sim_arm_state_t>;
+using MessageTypes = std::tuple<stereograsp::image_t, stereograsp::blob_t, stereograsp::point3_t,
+                                stereograsp::trajectory_t, stereograsp::arm_cmd_t,
+                                stereograsp::arm_status_t, stereograsp::grasp_command_t,
+                                stereograsp::grasp_status_t, stereograsp::sim_arm_state_t>;
 
 /// Calls `fn.template operator()<T>()` for each type T in MessageTypes.
 template <class Fn>
 void for_each_message_type(Fn&& fn) {
-  [&]<class... T>(std::tuple<T...>*) { (fn.template operator()<T>(), ...); }(
-      static_cast<MessageTypes*>(nullptr));
+  [&]<class... T>(std::tuple<T...>*) {
+    (fn.template operator()<T>(), ...);
+  }(static_cast<MessageTypes*>(nullptr));
 }
 
 }  // namespace sg

@@ -1,7 +1,6 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
-
 #include <functional>
 #include <string>
 
@@ -11,8 +10,8 @@ namespace sg {
 
 /// The options every stereograsp program takes (DESIGN rule 4).
 struct CommonOptions {
-  std::string lcm_url;        ///< --lcm-url; "" means LCM's default (honours LCM_DEFAULT_URL)
-  std::string config_path;    ///< --config FILE; "" means built-in defaults only
+  std::string lcm_url;             ///< --lcm-url; "" means LCM's default (honours LCM_DEFAULT_URL)
+  std::string config_path;         ///< --config FILE; "" means built-in defaults only
   std::string log_level = "info";  ///< --log-level
 };
 
@@ -28,7 +27,8 @@ Config load_common(CommonOptions& options);
 void init_logging(const std::string& program, const std::string& level);
 
 /// Runs a program's body with the errors every program shares turned into one line on stderr,
-/// `<program>: error: <what>`, and exit code 1 (flag errors: one line too, with CLI11's non-zero code).
+/// `<program>: error: <what>`, and exit code 1 (flag errors: one line too, with CLI11's non-zero
+/// code).
 ///
 ///     int main(int argc, char** argv) {
 ///       CLI::App app{"What it does", "sg-thing"};

@@ -7,13 +7,13 @@
 // contents derived from its utime; `receive` checks every byte and reports loss, corruption and
 // latency; `verify-log` checks a log that lcm-logger recorded of such a stream.
 
-#include <lcm/lcm-cpp.hpp>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <lcm/lcm-cpp.hpp>
 #include <map>
 #include <set>
 #include <thread>
@@ -96,7 +96,8 @@ class Tally {
 
   std::string per_channel() const {
     std::string text;
-    for (const auto& [name, n] : per_channel_) text += "  " + name + ": " + std::to_string(n) + "\n";
+    for (const auto& [name, n] : per_channel_)
+      text += "  " + name + ": " + std::to_string(n) + "\n";
     return text;
   }
 
@@ -116,14 +117,16 @@ int run_send(sg::Bus& bus, const SendOptions& options) {
   int64_t sent = 0;
   for (; options.count == 0 || sent < options.count; ++sent) {
     if (sg::shutdown_requested()) break;
-    if (options.duration_s > 0 && steady_clock::now() - start >= duration<double>(options.duration_s))
+    if (options.duration_s > 0 &&
+        steady_clock::now() - start >= duration<double>(options.duration_s))
       break;
     const int type_index = static_cast<int>(sent % sg::bus_check::type_count());
     last_utime = std::max(sg::now_utime(), last_utime + 1);  // unique, increasing
     const std::vector<uint8_t> bytes = sg::bus_check::encode(type_index, last_utime);
     bus.publish_raw(sg::bus_check::channel(type_index), bytes.data(),
                     static_cast<int>(bytes.size()));
-    std::this_thread::sleep_until(start + duration_cast<steady_clock::duration>(period * (sent + 1)));
+    std::this_thread::sleep_until(start +
+                                  duration_cast<steady_clock::duration>(period * (sent + 1)));
   }
   const double seconds = duration<double>(steady_clock::now() - start).count();
   std::printf("sent %lld messages of %d types in %.2f s (%lld publish errors)\n",
@@ -185,9 +188,9 @@ int main(int argc, char** argv) {
   CLI::Option* send_count = send_cmd->add_option("--count", send.count,
                                                  "messages to send, 0 for no limit (default 1000, "
                                                  "config bus_check.count)");
-  CLI::Option* send_rate =
-      send_cmd->add_option("--rate", send.rate_hz, "messages per second (default 100, config "
-                                                   "bus_check.rate_hz)");
+  CLI::Option* send_rate = send_cmd->add_option("--rate", send.rate_hz,
+                                                "messages per second (default 100, config "
+                                                "bus_check.rate_hz)");
   send_cmd->add_option("--duration", send.duration_s, "stop after this many seconds (0: no limit)")
       ->check(CLI::NonNegativeNumber);
 

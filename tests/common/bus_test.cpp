@@ -48,9 +48,8 @@ TEST(Bus, TypedPublishSubscribeOverMemq) {
 TEST(Bus, SubscribesByRegex) {
   Bus bus("memq://");
   std::vector<std::string> channels;
-  bus.subscribe<blob_t>("BLOB_.*", [&](const blob_t&, const ReceiveInfo& info) {
-    channels.push_back(info.channel);
-  });
+  bus.subscribe<blob_t>(
+      "BLOB_.*", [&](const blob_t&, const ReceiveInfo& info) { channels.push_back(info.channel); });
   blob_t blob{};
   bus.publish("BLOB_LEFT", blob);
   bus.publish("BLOB_RIGHT", blob);
@@ -127,8 +126,8 @@ TEST(Bus, FileUrlReportsEndOfLog) {
   }
   Bus reader("file://" + path + "?mode=r&speed=0");
   std::vector<int64_t> utimes;
-  reader.subscribe<point3_t>("OBJECT_POSITION",
-                             [&](const point3_t& p, const ReceiveInfo&) { utimes.push_back(p.utime); });
+  reader.subscribe<point3_t>(
+      "OBJECT_POSITION", [&](const point3_t& p, const ReceiveInfo&) { utimes.push_back(p.utime); });
   reader.spin([] { return true; }, 100ms);
   EXPECT_TRUE(reader.end_of_log());
   EXPECT_EQ(utimes, (std::vector<int64_t>{42, 43}));

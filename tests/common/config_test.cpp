@@ -26,7 +26,8 @@ TEST(Config, ReadsDottedKeysAndDefaults) {
   EXPECT_EQ(config.get<std::string>("bus.url", ""), "udpm://239.255.76.67:7667?ttl=1");
   EXPECT_EQ(config.require<int>("predictor.order"), 12);
   EXPECT_DOUBLE_EQ(config.get<double>("predictor.period", 1.0), 0.25);
-  EXPECT_EQ(config.get<std::vector<int>>("predictor.horizon_steps", {}), (std::vector<int>{1, 4, 16}));
+  EXPECT_EQ(config.get<std::vector<int>>("predictor.horizon_steps", {}),
+            (std::vector<int>{1, 4, 16}));
   EXPECT_TRUE(config.get<bool>("predictor.enabled", false));
   EXPECT_DOUBLE_EQ(config.get<double>("predictor.absent", 7.5), 7.5);
   EXPECT_DOUBLE_EQ(config.get<double>("absent_section.key", -1.0), -1.0);
@@ -41,7 +42,8 @@ TEST(Config, WrongTypeNamesFileLineAndKey) {
     config.get<int>("predictor.order", 8);
     FAIL() << "no error";
   } catch (const ConfigError& e) {
-    EXPECT_STREQ(e.what(), "lab.yaml:2:10: key 'predictor.order': expected an integer, got 'twelve'");
+    EXPECT_STREQ(e.what(),
+                 "lab.yaml:2:10: key 'predictor.order': expected an integer, got 'twelve'");
   }
 }
 

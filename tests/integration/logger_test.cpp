@@ -2,11 +2,11 @@
 // stock lcm-logplayer replays it to a subscriber.
 
 #include <gtest/gtest.h>
-#include <lcm/lcm-cpp.hpp>
 #include <signal.h>
 
 #include <filesystem>
 #include <fstream>
+#include <lcm/lcm-cpp.hpp>
 #include <thread>
 
 #include "common/bus_check.hpp"
@@ -29,10 +29,10 @@ class LoggerTest : public ::testing::Test {
     log_path_ = dir_ + "/session.lcmlog";
     Child logger({SG_LCM_LOGGER, "--lcm-url=" + test_url(7902), "-c", "BUS_CHECK_.*", log_path_});
     std::this_thread::sleep_for(1s);  // let the logger join the group
-    const ProcessResult sender = run({program("sg-bus-check"), "send", "--count",
-                                      std::to_string(kCount), "--rate", "200", "--lcm-url",
-                                      test_url(7902)},
-                                     60s);
+    const ProcessResult sender =
+        run({program("sg-bus-check"), "send", "--count", std::to_string(kCount), "--rate", "200",
+             "--lcm-url", test_url(7902)},
+            60s);
     ASSERT_EQ(sender.exit_code, 0) << sender.err;
     std::this_thread::sleep_for(300ms);
     logger.signal(SIGINT);
@@ -54,9 +54,8 @@ TEST_F(LoggerTest, LogFileReadsBackExactlyWhatWasSent) {
   int64_t last_utime = 0;
   int64_t last_timestamp = 0;
   while (const lcm::LogEvent* event = log.readNextEvent()) {
-    const auto verdict = bus_check::verify(event->channel,
-                                           static_cast<const uint8_t*>(event->data),
-                                           event->datalen);
+    const auto verdict =
+        bus_check::verify(event->channel, static_cast<const uint8_t*>(event->data), event->datalen);
     ASSERT_TRUE(verdict.has_value()) << event->channel;
     EXPECT_TRUE(verdict->intact) << "event " << events;
     EXPECT_EQ(verdict->type_index, events % bus_check::type_count()) << "sent in this order";
@@ -73,8 +72,8 @@ TEST_F(LoggerTest, LogFileReadsBackExactlyWhatWasSent) {
 // sg-bus-check verify-log agrees, and a log cut in the middle of an event is read up to the cut
 // and reported short, without a crash.
 TEST_F(LoggerTest, VerifyLogAcceptsTheLogAndReportsATruncatedOne) {
-  const ProcessResult whole = run({program("sg-bus-check"), "verify-log", log_path_, "--count",
-                                   std::to_string(kCount)});
+  const ProcessResult whole =
+      run({program("sg-bus-check"), "verify-log", log_path_, "--count", std::to_string(kCount)});
   EXPECT_EQ(whole.exit_code, 0) << whole.out << whole.err;
 
   const std::string cut = dir_ + "/cut.lcmlog";

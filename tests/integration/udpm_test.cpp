@@ -17,12 +17,11 @@ TEST(Udpm, ThousandMessagesAt100HzBetweenProcessesNoneLost) {
   constexpr int kPort = 7901;
   ASSERT_TRUE(multicast_available(kPort));
   const std::string url = test_url(kPort);
-  Child receiver({program("sg-bus-check"), "receive", "--count", "1000", "--timeout", "10",
-                  "--lcm-url", url});
+  Child receiver(
+      {program("sg-bus-check"), "receive", "--count", "1000", "--timeout", "10", "--lcm-url", url});
   std::this_thread::sleep_for(1s);  // let the receiver join the group
-  const ProcessResult sender = run({program("sg-bus-check"), "send", "--count", "1000", "--rate",
-                                    "100", "--lcm-url", url},
-                                   60s);
+  const ProcessResult sender = run(
+      {program("sg-bus-check"), "send", "--count", "1000", "--rate", "100", "--lcm-url", url}, 60s);
   ASSERT_EQ(sender.exit_code, 0) << sender.err;
   EXPECT_NE(sender.out.find("sent 1000 messages of 9 types"), std::string::npos) << sender.out;
   const ProcessResult received = receiver.wait(30s);

@@ -3,7 +3,8 @@
 // the form of tests/support/field_dump.hpp, so a C++ test can compare field values.
 //
 // Usage: java -cp <types jar>:lcm.jar:jchart2d.jar:<this jar> LcmDump FILE...
-// Each FILE holds one encoded message. Output per file: "type=<name>" then "path=value" lines
+// Each FILE holds one encoded message. Output per file: "type=<name>", "fingerprint=<hex>" (the
+// class's LCM_FINGERPRINT), then "path=value" lines
 // in path order, then a blank line. A fingerprint lcm-spy would not know prints "unknown=<hex>".
 
 import java.io.DataInputStream;
@@ -36,6 +37,8 @@ public class LcmDump {
       Map<String, String> fields = new TreeMap<>();
       dumpObject("", message, fields);
       out.append("type=").append(cls.getSimpleName()).append('\n');
+      long classFingerprint = cls.getField("LCM_FINGERPRINT").getLong(null);
+      out.append(String.format("fingerprint=%016x%n", classFingerprint));
       for (Map.Entry<String, String> e : fields.entrySet()) {
         out.append(e.getKey()).append('=').append(e.getValue()).append('\n');
       }

@@ -14,7 +14,8 @@ namespace {
 
 std::string write_message(const std::string& path, const std::vector<uint8_t>& bytes) {
   std::ofstream file(path, std::ios::binary);
-  file.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  file.write(reinterpret_cast<const char*>(bytes.data()),
+             static_cast<std::streamsize>(bytes.size()));
   return path;
 }
 
@@ -49,9 +50,9 @@ TEST(JavaDecode, ForeignFingerprintIsUnknown) {
   std::vector<uint8_t> bytes = encode(make_sample<stereograsp::point3_t>(SampleKind::kTypical));
   bytes[0] ^= 0x5a;  // corrupt the fingerprint
   const std::string dir = make_temp_dir();
-  const ProcessResult java = run({"java", "-cp", SG_JAVA_CLASSPATH, "LcmDump",
-                                  write_message(dir + "/foreign.bin", bytes)},
-                                 std::chrono::seconds(60));
+  const ProcessResult java =
+      run({"java", "-cp", SG_JAVA_CLASSPATH, "LcmDump", write_message(dir + "/foreign.bin", bytes)},
+          std::chrono::seconds(60));
   ASSERT_EQ(java.exit_code, 0) << java.err;
   EXPECT_EQ(java.out.rfind("unknown=", 0), 0u) << java.out;
 }

@@ -11,11 +11,10 @@ namespace {
 template <class T>
 class RoundTripTest : public ::testing::Test {};
 
-using AllTypes =
-    ::testing::Types<stereograsp::image_t, stereograsp::blob_t, stereograsp::point3_t,
-                     stereograsp::trajectory_t, stereograsp::arm_cmd_t, stereograsp::arm_status_t,
-                     stereograsp::grasp_command_t, stereograsp::grasp_status_t,
-                     stereograsp::sim_arm_state_t>;
+using AllTypes = ::testing::Types<stereograsp::image_t, stereograsp::blob_t, stereograsp::point3_t,
+                                  stereograsp::trajectory_t, stereograsp::arm_cmd_t,
+                                  stereograsp::arm_status_t, stereograsp::grasp_command_t,
+                                  stereograsp::grasp_status_t, stereograsp::sim_arm_state_t>;
 TYPED_TEST_SUITE(RoundTripTest, AllTypes);
 
 template <class T>

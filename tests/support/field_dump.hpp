@@ -15,8 +15,8 @@ namespace sg::test {
 /// Every field of a message as `path=value` lines in path order, in a form that a Java program
 /// produces too (tests/lcmtypes/LcmDump.java): doubles by their bits (`d:7ff8000000000000`, so NaN
 /// and -0.0 compare exactly), integers and booleans in decimal (booleans 0/1), strings and byte
-/// arrays as hex (`s:...`, `x:...`; over 64 bytes as length and 64-bit FNV-1a hash, `x:#921600:...`),
-/// array elements as `name[i]`.
+/// arrays as hex (`s:...`, `x:...`; over 64 bytes as length and 64-bit FNV-1a hash,
+/// `x:#921600:...`), array elements as `name[i]`.
 class FieldDump {
  public:
   template <class T>
@@ -34,7 +34,8 @@ class FieldDump {
     } else if constexpr (std::is_same_v<T, std::vector<uint8_t>>) {
       fields_[name] = "x:" + hex(value.data(), value.size());
     } else if constexpr (std::is_array_v<T>) {
-      for (size_t i = 0; i < std::extent_v<T>; ++i) add(name + "[" + std::to_string(i) + "]", value[i]);
+      for (size_t i = 0; i < std::extent_v<T>; ++i)
+        add(name + "[" + std::to_string(i) + "]", value[i]);
     } else {  // std::vector of anything else
       for (size_t i = 0; i < value.size(); ++i) add(name + "[" + std::to_string(i) + "]", value[i]);
     }
@@ -68,6 +69,7 @@ class FieldDump {
   std::map<std::string, std::string> fields_;
 };
 
+// clang-format off
 /// Each type's fields, in any order, for a visitor with `template <class T> add(name, T& value)`.
 #define SG_FIELD(f) v.add(#f, m.f)
 
@@ -123,14 +125,18 @@ inline void visit_fields(stereograsp::sim_arm_state_t& m, V& v) {
   SG_FIELD(gripper_opening); SG_FIELD(holding_object);
 }
 
+// clang-format on
 #undef SG_FIELD
 
-/// The dump of one message, headed by its type name.
+/// The dump of one message, headed by its type name and fingerprint.
 template <class Message>
 std::string dump(Message message) {
   FieldDump d;
   visit_fields(message, d);
-  return std::string("type=") + Message::getTypeName() + "\n" + d.text();
+  char fingerprint[40];
+  std::snprintf(fingerprint, sizeof fingerprint, "fingerprint=%016" PRIx64 "\n",
+                static_cast<uint64_t>(Message::getHash()));
+  return std::string("type=") + Message::getTypeName() + "\n" + fingerprint + d.text();
 }
 
 }  // namespace sg::test

@@ -37,7 +37,9 @@ class SampleFiller {
       for (size_t i = 0; i < value.size(); ++i) value[i] = static_cast<uint8_t>(i * 7 + 3);
     } else if constexpr (std::is_same_v<T, std::vector<std::vector<double>>>) {
       // The only variable 2-D array is trajectory_t.position[n][3].
-      value.assign(kind_ == SampleKind::kEmpty ? 0 : kind_ == SampleKind::kTypical ? 16 : 10000,
+      value.assign(kind_ == SampleKind::kEmpty     ? 0
+                   : kind_ == SampleKind::kTypical ? 16
+                                                   : 10000,
                    std::vector<double>(3));
       for (auto& row : value) add(name, row);
     } else if constexpr (std::is_array_v<T>) {

@@ -12,8 +12,8 @@ namespace sg::test {
 struct ProcessResult {
   int exit_code = -1;  ///< exit status, or 128 + signal number when killed by a signal
   bool timed_out = false;
-  std::string out;     ///< everything it wrote to stdout
-  std::string err;     ///< everything it wrote to stderr
+  std::string out;  ///< everything it wrote to stdout
+  std::string err;  ///< everything it wrote to stderr
 };
 
 /// A child process started from argv (no shell), its stdout and stderr captured in files.
