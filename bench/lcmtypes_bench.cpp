@@ -34,13 +34,6 @@ trajectory_t make_trajectory() {
   return t;
 }
 
-template <class T>
-std::vector<uint8_t> encoded(const T& m) {
-  std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
-  m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  return bytes;
-}
-
 // Baseline: copy a 640x480 BGR frame's bytes.
 void BM_Image_CopyBaseline(benchmark::State& state) {
   const image_t image = make_image();
@@ -65,7 +58,7 @@ void BM_Image_Encode(benchmark::State& state) {
 BENCHMARK(BM_Image_Encode);
 
 void BM_Image_Decode(benchmark::State& state) {
-  const std::vector<uint8_t> bytes = encoded(make_image());
+  const std::vector<uint8_t> bytes = sg::encode_message(make_image());
   image_t image{};
   for (auto _ : state) {
     image.decode(bytes.data(), 0, static_cast<int>(bytes.size()));

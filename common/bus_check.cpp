@@ -157,9 +157,7 @@ std::vector<uint8_t> encode_as(int64_t utime) {
   message.utime = utime;
   Pattern pattern(utime);
   fill(message, pattern);
-  std::vector<uint8_t> bytes(static_cast<size_t>(message.getEncodedSize()));
-  message.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  return bytes;
+  return encode_message(message);
 }
 
 template <class T>

@@ -1,6 +1,8 @@
 #pragma once
 
+#include <cstdint>
 #include <tuple>
+#include <vector>
 
 #include "stereograsp/arm_cmd_t.hpp"
 #include "stereograsp/arm_status_t.hpp"
@@ -27,6 +29,14 @@ void for_each_message_type(Fn&& fn) {
   [&]<class... T>(std::tuple<T...>*) {
     (fn.template operator()<T>(), ...);
   }(static_cast<MessageTypes*>(nullptr));
+}
+
+/// The encoded bytes of one message (fingerprint first), as LCM sends them.
+template <class Message>
+std::vector<uint8_t> encode_message(const Message& message) {
+  std::vector<uint8_t> bytes(static_cast<size_t>(message.getEncodedSize()));
+  message.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
 }
 
 }  // namespace sg

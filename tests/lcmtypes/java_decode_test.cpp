@@ -19,13 +19,6 @@ std::string write_message(const std::string& path, const std::vector<uint8_t>& b
   return path;
 }
 
-template <class T>
-std::vector<uint8_t> encode(const T& message) {
-  std::vector<uint8_t> bytes(static_cast<size_t>(message.getEncodedSize()));
-  message.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
-  return bytes;
-}
-
 // Every type, with empty, typical and extreme values, decodes in Java to the same fields.
 TEST(JavaDecode, EveryTypeDecodesToEqualFieldsThroughLcmSpysTypeDatabase) {
   const std::string dir = make_temp_dir();
@@ -35,7 +28,8 @@ TEST(JavaDecode, EveryTypeDecodesToEqualFieldsThroughLcmSpysTypeDatabase) {
   for (SampleKind kind : {SampleKind::kEmpty, SampleKind::kTypical, SampleKind::kExtreme}) {
     for_each_message_type([&]<class T>() {
       const T message = make_sample<T>(kind);
-      argv.push_back(write_message(dir + "/" + std::to_string(n++) + ".bin", encode(message)));
+      argv.push_back(
+          write_message(dir + "/" + std::to_string(n++) + ".bin", encode_message(message)));
       expected += dump(message) + "\n";
     });
   }
@@ -47,7 +41,8 @@ TEST(JavaDecode, EveryTypeDecodesToEqualFieldsThroughLcmSpysTypeDatabase) {
 
 // A message whose fingerprint is not a stereograsp type is reported unknown, not misread.
 TEST(JavaDecode, ForeignFingerprintIsUnknown) {
-  std::vector<uint8_t> bytes = encode(make_sample<stereograsp::point3_t>(SampleKind::kTypical));
+  std::vector<uint8_t> bytes =
+      encode_message(make_sample<stereograsp::point3_t>(SampleKind::kTypical));
   bytes[0] ^= 0x5a;  // corrupt the fingerprint
   const std::string dir = make_temp_dir();
   const ProcessResult java =

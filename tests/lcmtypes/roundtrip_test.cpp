@@ -19,9 +19,8 @@ TYPED_TEST_SUITE(RoundTripTest, AllTypes);
 
 template <class T>
 std::vector<uint8_t> encode(const T& message) {
-  std::vector<uint8_t> bytes(static_cast<size_t>(message.getEncodedSize()));
-  EXPECT_EQ(message.encode(bytes.data(), 0, static_cast<int>(bytes.size())),
-            static_cast<int>(bytes.size()));
+  std::vector<uint8_t> bytes = encode_message(message);
+  EXPECT_EQ(static_cast<int>(bytes.size()), message.getEncodedSize());
   return bytes;
 }
 
