@@ -30,6 +30,7 @@ packages=(
   default-jdk-headless default-jre libjchart2d-java  # the types jar, lcm-spy and its charts
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev  # config, flags, logging
   libeigen3-dev                                    # linear algebra
+  libopencv-dev                                    # images, video files, calibration
   libgtest-dev libgmock-dev libbenchmark-dev       # tests and benchmarks
   iproute2 util-linux                              # ip and unshare for scripts/multicast.sh
 )

@@ -1,0 +1,96 @@
+// Calibration files: exact round trip, errors that name the key, no partial file over a good one.
+
+#include "vision/calibration_file.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "tests/support/subprocess.hpp"
+
+namespace sg::vision {
+namespace {
+
+StereoCalibration sample() {
+  StereoCalibration c;
+  c.left = CameraModel::look_at(640, 480, {530.5, 529.25, 321.0, 238.5},
+                                {-0.2, 0.05, 0.001, -0.002, 0.01}, {0.8, -0.25, 0.4}, {0.45, 0, 0.1});
+  c.right = CameraModel::look_at(640, 480, {531.0, 530.0, 318.0, 241.0}, {}, {0.8, 0.25, 0.4},
+                                 {0.45, 0, 0.1});
+  c.rms_left = 0.21;
+  c.rms_right = 0.18;
+  c.source = "test";
+  return c;
+}
+
+std::string text_of(const std::string& path) {
+  std::ifstream file(path);
+  std::stringstream s;
+  s << file.rdbuf();
+  return s.str();
+}
+
+// What is written is read back: every parameter to 1e-12.
+TEST(CalibrationFile, RoundTrip) {
+  const std::string path = test::make_temp_dir() + "/stereo.yaml";
+  write_calibration(path, sample());
+  const StereoCalibration back = read_calibration(path);
+  for (const auto& [a, b] : {std::pair{sample().left, back.left}, {sample().right, back.right}}) {
+    EXPECT_TRUE(a.K().isApprox(b.K(), 1e-12));
+    EXPECT_TRUE(a.R().isApprox(b.R(), 1e-12));
+    EXPECT_TRUE(a.t().isApprox(b.t(), 1e-12));
+    EXPECT_NEAR(a.distortion().k1, b.distortion().k1, 1e-15);
+    EXPECT_NEAR(a.distortion().p2, b.distortion().p2, 1e-15);
+    EXPECT_EQ(b.width(), 640);
+  }
+  EXPECT_DOUBLE_EQ(back.rms_left, 0.21);
+  EXPECT_EQ(back.source, "test");
+  EXPECT_FALSE(back.date.empty());
+  EXPECT_NE(text_of(path).find("P: !!opencv-matrix"), std::string::npos) << "P is written too";
+}
+
+// A missing or malformed key is named.
+TEST(CalibrationFile, BadKeysAreNamed) {
+  const std::string dir = test::make_temp_dir();
+  write_calibration(dir + "/good.yaml", sample());
+  const std::string good = text_of(dir + "/good.yaml");
+
+  std::string no_k = good;
+  const size_t right = no_k.find("camera_right");
+  no_k.replace(no_k.find("   K:", right), 5, "   Q:");
+  std::ofstream(dir + "/no_k.yaml") << no_k;
+  try {
+    read_calibration(dir + "/no_k.yaml");
+    FAIL() << "accepted";
+  } catch (const CalibrationError& e) {
+    EXPECT_NE(std::string(e.what()).find("'camera_right.K' is missing"), std::string::npos)
+        << e.what();
+  }
+
+  std::string bad_version = good;
+  bad_version.replace(bad_version.find("format_version: 1"), 17, "format_version: 7");
+  std::ofstream(dir + "/v7.yaml") << bad_version;
+  EXPECT_THROW(read_calibration(dir + "/v7.yaml"), CalibrationError);
+
+  std::ofstream(dir + "/garbage.yaml") << "%YAML:1.0\n---\nthis: [is, not\n";
+  EXPECT_THROW(read_calibration(dir + "/garbage.yaml"), CalibrationError);
+  EXPECT_THROW(read_calibration(dir + "/absent.yaml"), CalibrationError);
+}
+
+// A failed write leaves the good file that was there.
+TEST(CalibrationFile, FailedWriteKeepsTheOldFile) {
+  const std::string dir = test::make_temp_dir();
+  const std::string path = dir + "/stereo.yaml";
+  write_calibration(path, sample());
+  const std::string before = text_of(path);
+  std::filesystem::create_directory(path + ".tmp");  // the temporary cannot be created
+  StereoCalibration swapped = sample();
+  std::swap(swapped.left, swapped.right);
+  EXPECT_THROW(write_calibration(path, swapped), CalibrationError);
+  EXPECT_EQ(text_of(path), before);
+}
+
+}  // namespace
+}  // namespace sg::vision
