@@ -25,8 +25,8 @@ void BM_Pair_CopyBaseline(benchmark::State& state) {
     sim.renderer(1).background().copyTo(right);
     benchmark::DoNotOptimize(left.data);
   }
-  state.counters["pairs_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()),
-                                                     benchmark::Counter::kIsRate);
+  state.counters["pairs_per_s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_Pair_CopyBaseline)->Unit(benchmark::kMicrosecond);
 
@@ -36,8 +36,8 @@ void BM_Pair_Render(benchmark::State& state) {
   sg::sim::StereoFrame frame;
   int64_t k = 0;
   for (auto _ : state) sim.render(k++, {}, frame);
-  state.counters["pairs_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()),
-                                                     benchmark::Counter::kIsRate);
+  state.counters["pairs_per_s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_Pair_Render)->Unit(benchmark::kMicrosecond);
 
@@ -53,8 +53,8 @@ void BM_Pair_RenderWithGripperAndOccluder(benchmark::State& state) {
     arm.tool_position = sim.ball_position(k, {}) + Eigen::Vector3d(0, 0, 0.05);
     sim.render(k++, arm, frame);
   }
-  state.counters["pairs_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()),
-                                                     benchmark::Counter::kIsRate);
+  state.counters["pairs_per_s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_Pair_RenderWithGripperAndOccluder)->Unit(benchmark::kMicrosecond);
 

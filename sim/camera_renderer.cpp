@@ -1,23 +1,24 @@
 #include "sim/camera_renderer.hpp"
 
-#include <opencv2/imgproc.hpp>
-
 #include <algorithm>
 #include <cmath>
+#include <opencv2/imgproc.hpp>
 #include <random>
 
 namespace sg::sim {
 namespace {
 
-constexpr int kSuper = 4;          // edge pixels: kSuper x kSuper rays
-constexpr int kNoiseFrames = 8;    // sensor-noise frames, reused in turn
+constexpr int kSuper = 4;        // edge pixels: kSuper x kSuper rays
+constexpr int kNoiseFrames = 8;  // sensor-noise frames, reused in turn
 
 cv::Vec3b to_pixel(const Eigen::Vector3d& bgr) {
   return {cv::saturate_cast<uint8_t>(bgr.x()), cv::saturate_cast<uint8_t>(bgr.y()),
           cv::saturate_cast<uint8_t>(bgr.z())};
 }
 
-Eigen::Vector3d from_pixel(const cv::Vec3b& p) { return {double(p[0]), double(p[1]), double(p[2])}; }
+Eigen::Vector3d from_pixel(const cv::Vec3b& p) {
+  return {double(p[0]), double(p[1]), double(p[2])};
+}
 
 /// Bilinear blend of the rays through a pixel's four corners, at (u, v) in [0, 1]^2.
 Eigen::Vector3d blend(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
@@ -29,7 +30,8 @@ Eigen::Vector3d blend(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const 
 std::vector<Eigen::Vector3d> sphere_cube(const Eigen::Vector3d& centre, double radius) {
   std::vector<Eigen::Vector3d> cube;
   for (int i = 0; i < 8; ++i) {
-    cube.push_back(centre + radius * Eigen::Vector3d(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1));
+    cube.push_back(centre +
+                   radius * Eigen::Vector3d(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1));
   }
   return cube;
 }
@@ -44,7 +46,8 @@ struct Sticker {
 };
 
 Eigen::Vector3d wood(double x, double y) {
-  const double grain = 0.5 + 0.5 * std::sin(90 * y + 3 * std::sin(5 * x) + std::sin(17 * x + 2 * y));
+  const double grain =
+      0.5 + 0.5 * std::sin(90 * y + 3 * std::sin(5 * x) + std::sin(17 * x + 2 * y));
   const double plank = std::fmod(std::abs(y) + 10, 0.18) < 0.003 ? 0.6 : 1.0;
   return Eigen::Vector3d(0.26, 0.44, 0.62) * (0.9 + 0.1 * grain) * plank;
 }
@@ -120,7 +123,8 @@ void CameraRenderer::render_background(const StaticSceneParams& params) {
     const double radius = 0.008 + 0.006 * unit(rng);
     if (i % 2 == 0) {  // on the table, away from the ball's usual path around (0.45, 0)
       const double angle = 2 * M_PI * unit(rng), distance = 0.32 + 0.12 * unit(rng);
-      stickers.push_back({{0.45 + distance * std::cos(angle), distance * std::sin(angle), 0.0}, radius});
+      stickers.push_back(
+          {{0.45 + distance * std::cos(angle), distance * std::sin(angle), 0.0}, radius});
     } else {  // on the wall
       stickers.push_back({{params.wall_x, -0.6 + 1.2 * unit(rng), 0.1 + 0.5 * unit(rng)}, radius});
     }
@@ -190,7 +194,8 @@ void CameraRenderer::make_noise(double sigma, uint64_t seed) {
   }
 }
 
-std::optional<cv::Rect> CameraRenderer::screen_box(const std::vector<Eigen::Vector3d>& points) const {
+std::optional<cv::Rect> CameraRenderer::screen_box(
+    const std::vector<Eigen::Vector3d>& points) const {
   double x0 = 1e18, y0 = 1e18, x1 = -1e18, y1 = -1e18;
   for (const Eigen::Vector3d& p : points) {
     const auto pixel = camera_.project(p);
@@ -208,8 +213,8 @@ std::optional<cv::Rect> CameraRenderer::screen_box(const std::vector<Eigen::Vect
   return clipped;
 }
 
-double CameraRenderer::render_region(const Objects& objects, const cv::Rect& region,
-                                     cv::Mat& image, cv::Mat* ball_coverage) const {
+double CameraRenderer::render_region(const Objects& objects, const cv::Rect& region, cv::Mat& image,
+                                     cv::Mat* ball_coverage) const {
   const int rw = region.width, rh = region.height;
   std::vector<int> ids(static_cast<size_t>(rw + 1) * (rh + 1));
   for (int y = 0; y <= rh; ++y) {
@@ -243,8 +248,8 @@ double CameraRenderer::render_region(const Objects& objects, const cv::Rect& reg
           for (int sx = 0; sx < kSuper; ++sx) {
             const double u = (sx + 0.5) / kSuper, v = (sy + 0.5) / kSuper;
             const Ray ray{eye_, blend(ra, rb, rc, rd, u, v)};
-            const Hit hit = objects.nearest(ray, cv::Point2f(static_cast<float>(px + u),
-                                                             static_cast<float>(py + v)));
+            const Hit hit = objects.nearest(
+                ray, cv::Point2f(static_cast<float>(px + u), static_cast<float>(py + v)));
             sum += hit.object < 0 ? behind : objects.colour(hit, ray, to_light_);
             on_ball += hit.object == 0;
           }
@@ -284,8 +289,8 @@ void CameraRenderer::apply_exposure(const DynamicScene& scene, cv::Mat& image) c
   if ((g - Eigen::Vector3d::Ones()).cwiseAbs().maxCoeff() > 1e-6) {
     cv::multiply(image, cv::Scalar(g.x(), g.y(), g.z()), image);
   }
-  const size_t k = static_cast<size_t>(((scene.noise_frame % kNoiseFrames) + kNoiseFrames) %
-                                       kNoiseFrames);
+  const size_t k =
+      static_cast<size_t>(((scene.noise_frame % kNoiseFrames) + kNoiseFrames) % kNoiseFrames);
   cv::add(image, noise_up_[k], image);
   cv::subtract(image, noise_down_[k], image);
 }

@@ -1,7 +1,6 @@
 #pragma once
 
 #include <opencv2/core.hpp>
-
 #include <optional>
 #include <vector>
 
@@ -14,8 +13,8 @@ namespace sg::sim {
 /// wall with a poster behind the robot, the robot's base, and small red stickers of the ball's hue
 /// (distractors). Rendered once per camera.
 struct StaticSceneParams {
-  double wall_x = -0.45;          ///< the wall is the plane X = wall_x, facing +X
-  int distractors = 4;            ///< red stickers of 8-14 mm radius on the table and the wall
+  double wall_x = -0.45;  ///< the wall is the plane X = wall_x, facing +X
+  int distractors = 4;    ///< red stickers of 8-14 mm radius on the table and the wall
   Eigen::Vector3d to_light{0.35, -0.25, 1.0};  ///< direction toward the light (normalized in use)
   uint64_t seed = 1;
 };
@@ -89,8 +88,8 @@ class CameraRenderer {
   vision::CameraModel camera_;
   Eigen::Vector3d eye_;
   Eigen::Vector3d to_light_;
-  std::vector<Eigen::Vector3d> corner_rays_;  // world-frame unit rays through pixel corners
-  cv::Mat background_;                        // CV_8UC3
+  std::vector<Eigen::Vector3d> corner_rays_;    // world-frame unit rays through pixel corners
+  cv::Mat background_;                          // CV_8UC3
   std::vector<cv::Mat> noise_up_, noise_down_;  // CV_8UC3 positive and negative parts
 };
 

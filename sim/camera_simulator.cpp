@@ -37,8 +37,8 @@ DynamicScene CameraSimulator::dynamic_scene(double t, const Eigen::Vector3d& bal
   scene.ball_radius = params_.ball_radius;
   scene.ball_material.albedo = {0.10, 0.12, 0.80};
   scene.ball_material.specular = 0.5;
-  const bool blur = params_.exposure > 0 && params_.motion_blur_samples > 1 && !carried_ &&
-                    !dropped_at_;
+  const bool blur =
+      params_.exposure > 0 && params_.motion_blur_samples > 1 && !carried_ && !dropped_at_;
   if (blur) {
     for (int s = 0; s < params_.motion_blur_samples; ++s) {
       const double dt = params_.exposure * (s / (params_.motion_blur_samples - 1.0) - 0.5);
@@ -156,7 +156,8 @@ SimParams load_sim_params(const Config& c) {
   l.colour_amplitude = non_negative(c, "lighting.colour_amplitude", l.colour_amplitude);
   l.colour_period = positive(c, "lighting.colour_period", l.colour_period);
 
-  p.scene.distractors = static_cast<int>(non_negative(c, "camera_sim.distractors", p.scene.distractors));
+  p.scene.distractors =
+      static_cast<int>(non_negative(c, "camera_sim.distractors", p.scene.distractors));
   p.scene.seed = s.seed;
   p.ball_radius = positive(c, "camera_sim.ball_radius", p.ball_radius);
   p.noise_sigma = non_negative(c, "camera_sim.noise_sigma", p.noise_sigma);

@@ -14,10 +14,10 @@ namespace sg::sim {
 /// Lighting that changes over time: a global exposure gain and a slow drift of the colour
 /// balance, both sinusoidal.
 struct LightingParams {
-  double gain_amplitude = 0.10;   ///< gain = 1 + amplitude * sin(2 pi t / period)
-  double gain_period = 30.0;      ///< s
-  double colour_amplitude = 0.03; ///< per channel, phases 120 degrees apart
-  double colour_period = 45.0;    ///< s
+  double gain_amplitude = 0.10;    ///< gain = 1 + amplitude * sin(2 pi t / period)
+  double gain_period = 30.0;       ///< s
+  double colour_amplitude = 0.03;  ///< per channel, phases 120 degrees apart
+  double colour_period = 45.0;     ///< s
 };
 
 /// Everything the camera simulator needs; `load_sim_params` reads it from a Config.
@@ -27,22 +27,22 @@ struct SimParams {
   OcclusionParams occlusion;
   LightingParams lighting;
   StaticSceneParams scene;
-  double ball_radius = 0.035;       ///< m
-  double noise_sigma = 2.0;         ///< sensor noise, grey levels (standard deviation)
-  double exposure = 0.0;            ///< s; > 0 with motion_blur_samples > 1 blurs the ball
+  double ball_radius = 0.035;  ///< m
+  double noise_sigma = 2.0;    ///< sensor noise, grey levels (standard deviation)
+  double exposure = 0.0;       ///< s; > 0 with motion_blur_samples > 1 blurs the ball
   int motion_blur_samples = 1;
-  double frame_rate = 30.0;         ///< Hz
-  double min_visible_px = 10.0;     ///< a camera "sees" the ball when this much of it shows
+  double frame_rate = 30.0;      ///< Hz
+  double min_visible_px = 10.0;  ///< a camera "sees" the ball when this much of it shows
 };
 
 /// One rendered stereo pair and the truth behind it.
 struct StereoFrame {
-  int64_t index = 0;              ///< frame number from the start of the run
-  double time = 0.0;              ///< scenario time of the capture, index / frame_rate (s)
-  std::array<cv::Mat, 2> image;   ///< [0] left, [1] right; CV_8UC3 BGR
+  int64_t index = 0;             ///< frame number from the start of the run
+  double time = 0.0;             ///< scenario time of the capture, index / frame_rate (s)
+  std::array<cv::Mat, 2> image;  ///< [0] left, [1] right; CV_8UC3 BGR
   Eigen::Vector3d ball = Eigen::Vector3d::Zero();  ///< the ball's true centre, robot frame (m)
   std::array<BallVisibility, 2> visibility;
-  std::array<bool, 2> seen{false, false};          ///< visibility >= min_visible_px
+  std::array<bool, 2> seen{false, false};  ///< visibility >= min_visible_px
 };
 
 /// The stereo camera simulator's pure core: frame index and arm state in, images and truth out.
@@ -64,7 +64,9 @@ class CameraSimulator {
   /// Where the ball is at frame `index` with this arm state (updates the carried/dropped state).
   Eigen::Vector3d ball_position(int64_t index, const ArmState& arm);
 
-  const vision::CameraModel& camera(int i) const { return renderers_[static_cast<size_t>(i)]->camera(); }
+  const vision::CameraModel& camera(int i) const {
+    return renderers_[static_cast<size_t>(i)]->camera();
+  }
   const CameraRenderer& renderer(int i) const { return *renderers_[static_cast<size_t>(i)]; }
   const SimParams& params() const { return params_; }
 

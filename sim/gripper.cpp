@@ -20,8 +20,7 @@ std::vector<Box> gripper_boxes(const ArmState& arm) {
   const double finger_offset = arm.gripper_opening / 2 + 0.006;
   return {part({0, +finger_offset, -0.015}, {0.010, 0.006, 0.035}),
           part({0, -finger_offset, -0.015}, {0.010, 0.006, 0.035}),
-          part({0, 0, -0.065}, {0.020, 0.065, 0.015}),
-          part({0, 0, -0.120}, {0.025, 0.025, 0.040})};
+          part({0, 0, -0.065}, {0.020, 0.065, 0.015}), part({0, 0, -0.120}, {0.025, 0.025, 0.040})};
 }
 
 }  // namespace sg::sim

@@ -1,7 +1,6 @@
 #include "sim/occlusion.hpp"
 
 #include <Eigen/Geometry>
-
 #include <algorithm>
 
 namespace sg::sim {
@@ -28,9 +27,8 @@ double cover(const OcclusionParams& p, double t) {
 }  // namespace
 
 bool fully_occluded_at(const OcclusionParams& params, double t) {
-  return std::any_of(params.episodes.begin(), params.episodes.end(), [&](const auto& e) {
-    return t >= e.start && t <= e.start + e.duration;
-  });
+  return std::any_of(params.episodes.begin(), params.episodes.end(),
+                     [&](const auto& e) { return t >= e.start && t <= e.start + e.duration; });
 }
 
 std::optional<std::array<Eigen::Vector3d, 4>> occluder_at(const OcclusionParams& p, double t,

@@ -1,7 +1,6 @@
 #pragma once
 
 #include <Eigen/Core>
-
 #include <array>
 #include <optional>
 #include <vector>
@@ -20,9 +19,9 @@ struct OcclusionEpisode {
 /// partial.
 struct OcclusionParams {
   std::vector<OcclusionEpisode> episodes;
-  double transition = 0.3;   ///< seconds to slide in, and to slide out
-  double standoff = 0.10;    ///< distance from the ball's centre toward the cameras (m)
-  double width = 0.26;       ///< panel size (m); wide enough to hide the ball from both cameras
+  double transition = 0.3;  ///< seconds to slide in, and to slide out
+  double standoff = 0.10;   ///< distance from the ball's centre toward the cameras (m)
+  double width = 0.26;      ///< panel size (m); wide enough to hide the ball from both cameras
   double height = 0.20;
 };
 

@@ -54,7 +54,8 @@ class LineScenario : public Scenario {
  public:
   explicit LineScenario(const ScenarioParams& p) : p_(p), u_(p.line_direction.normalized()) {}
   Eigen::Vector3d position(double t) const override {
-    return p_.centre + u_ * triangle_drift(t, p_.line_speed, 2 * p_.line_half_length / p_.line_speed);
+    return p_.centre +
+           u_ * triangle_drift(t, p_.line_speed, 2 * p_.line_half_length / p_.line_speed);
   }
 
  private:
@@ -82,7 +83,8 @@ class RandomScenario : public Scenario {
   Eigen::Vector3d position(double t) const override {
     Eigen::Vector3d offset = Eigen::Vector3d::Zero();
     for (int axis = 0; axis < 3; ++axis) {
-      for (const auto& w : waves_[axis]) offset[axis] += w.amplitude * std::sin(w.omega * t + w.phase);
+      for (const auto& w : waves_[axis])
+        offset[axis] += w.amplitude * std::sin(w.omega * t + w.phase);
     }
     return p_.centre + offset;
   }
@@ -145,7 +147,8 @@ std::unique_ptr<Scenario> make_scenario(const ScenarioParams& p) {
   if (p.kind == "figure8") return std::make_unique<FigureEightScenario>(p);
   if (p.kind == "line") {
     check(p.line_direction.norm() > 0, "line_direction must not be zero");
-    check(p.line_speed > 0 && p.line_half_length > 0, "line_speed and line_half_length must be > 0");
+    check(p.line_speed > 0 && p.line_half_length > 0,
+          "line_speed and line_half_length must be > 0");
     return std::make_unique<LineScenario>(p);
   }
   if (p.kind == "random") {

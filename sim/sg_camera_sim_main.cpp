@@ -7,14 +7,14 @@
 //   sg-camera-sim --fast --frames 900 --write out/ # videos + ground_truth.csv + calibration.yaml
 //   sg-camera-sim --snapshot pair.png              # one stereo pair, side by side
 
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/videoio.hpp>
 #include <spdlog/spdlog.h>
 
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
 #include <thread>
 
 #include "common/bus.hpp"
@@ -116,9 +116,9 @@ int run_write(sg::sim::CameraSimulator& sim, const Options& o, int64_t frames) {
   fs::create_directories(o.write_dir);
   const double rate = sim.params().frame_rate;
   const cv::Size size(sim.camera(0).width(), sim.camera(0).height());
-  cv::VideoWriter left(o.write_dir + "/left.avi", cv::VideoWriter::fourcc('M', 'J', 'P', 'G'),
-                       rate, size), right(o.write_dir + "/right.avi",
-                       cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), rate, size);
+  cv::VideoWriter left(o.write_dir + "/left.avi", cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), rate,
+                       size),
+      right(o.write_dir + "/right.avi", cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), rate, size);
   if (!left.isOpened() || !right.isOpened())
     throw std::runtime_error(o.write_dir + ": cannot open the video files for writing");
   std::ofstream csv(o.write_dir + "/ground_truth.csv");
@@ -140,8 +140,10 @@ int run_write(sg::sim::CameraSimulator& sim, const Options& o, int64_t frames) {
     csv << line;
     if ((k + 1) % 100 == 0) spdlog::info("{} of {} frames written", k + 1, frames);
   }
-  std::printf("wrote %lld stereo frames to %s (left.avi, right.avi, ground_truth.csv, "
-              "calibration.yaml)\n", static_cast<long long>(frames), o.write_dir.c_str());
+  std::printf(
+      "wrote %lld stereo frames to %s (left.avi, right.avi, ground_truth.csv, "
+      "calibration.yaml)\n",
+      static_cast<long long>(frames), o.write_dir.c_str());
   return 0;
 }
 
@@ -150,8 +152,9 @@ int run_bus(sg::sim::CameraSimulator& sim, const Options& o, int64_t frames, boo
   sg::Bus bus(url);
   sg::sim::ArmState arm;
   bus.subscribe<stereograsp::sim_arm_state_t>(
-      "SIM_ARM_STATE",
-      [&](const stereograsp::sim_arm_state_t& m, const sg::ReceiveInfo&) { arm = to_arm_state(m); });
+      "SIM_ARM_STATE", [&](const stereograsp::sim_arm_state_t& m, const sg::ReceiveInfo&) {
+        arm = to_arm_state(m);
+      });
   const double rate = sim.params().frame_rate;
   const int64_t period_us = std::llround(1e6 / rate);
   const int64_t start_utime = sg::now_utime();
@@ -188,7 +191,8 @@ int main(int argc, char** argv) {
   sg::add_common_options(app, common);
   Options o;
   app.add_option("--rate", o.rate_hz, "frames per second (default 30, config camera_sim.rate_hz)");
-  app.add_flag("--fast", o.fast, "render as fast as possible (simulated time) instead of real time");
+  app.add_flag("--fast", o.fast,
+               "render as fast as possible (simulated time) instead of real time");
   app.add_option("--frames", o.frames, "stop after this many stereo frames (0: until Ctrl-C)");
   app.add_option("--encoding", o.encoding, "image_t encoding: jpeg (default) or raw")
       ->check(CLI::IsMember({"jpeg", "raw"}));

@@ -11,10 +11,10 @@ namespace sg::sim {
 /// `target`, looking down at `pitch` from the side given by `azimuth`.
 struct RigParams {
   Eigen::Vector3d target{0.45, 0.0, 0.10};  ///< where the optical axes meet, robot frame (m)
-  double baseline = 0.50;                    ///< distance between the camera centres (m)
-  double toe_in = 30.0 * M_PI / 180;         ///< each camera's turn toward the other (rad)
-  double pitch = 40.0 * M_PI / 180;          ///< elevation of the rig seen from the target (rad)
-  double azimuth = 0.0;                      ///< direction from the target to the rig, about Z
+  double baseline = 0.50;                   ///< distance between the camera centres (m)
+  double toe_in = 30.0 * M_PI / 180;        ///< each camera's turn toward the other (rad)
+  double pitch = 40.0 * M_PI / 180;         ///< elevation of the rig seen from the target (rad)
+  double azimuth = 0.0;                     ///< direction from the target to the rig, about Z
   int width = 640;
   int height = 480;
   vision::Intrinsics intrinsics{420.0, 420.0, 319.5, 239.5};

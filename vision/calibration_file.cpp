@@ -1,12 +1,11 @@
 #include "vision/calibration_file.hpp"
 
-#include <opencv2/core.hpp>
-#include <opencv2/core/eigen.hpp>
-
 #include <chrono>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
+#include <opencv2/core.hpp>
+#include <opencv2/core/eigen.hpp>
 
 namespace sg::vision {
 namespace {
@@ -57,8 +56,8 @@ cv::Mat read_matrix(const cv::FileNode& node, const std::string& path, const std
   return m;
 }
 
-CameraModel read_camera(const cv::FileNode& node, const std::string& path,
-                        const std::string& name, int width, int height, double* rms) {
+CameraModel read_camera(const cv::FileNode& node, const std::string& path, const std::string& name,
+                        int width, int height, double* rms) {
   if (node.empty()) throw CalibrationError(path + ": key '" + name + "' is missing");
   const cv::Mat K = read_matrix(node["K"], path, name + ".K", 3, 3);
   const cv::Mat D = read_matrix(node["distortion"], path, name + ".distortion", 1, 5);

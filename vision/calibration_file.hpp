@@ -19,10 +19,10 @@ class CalibrationError : public std::runtime_error {
 struct StereoCalibration {
   CameraModel left;
   CameraModel right;
-  double rms_left = 0.0;    ///< RMS reprojection error of the left camera, pixels
-  double rms_right = 0.0;   ///< RMS reprojection error of the right camera, pixels
-  std::string source;       ///< what produced it (e.g. "sg-camera-sim true calibration")
-  std::string date;         ///< when, ISO 8601 (filled by write_calibration when empty)
+  double rms_left = 0.0;   ///< RMS reprojection error of the left camera, pixels
+  double rms_right = 0.0;  ///< RMS reprojection error of the right camera, pixels
+  std::string source;      ///< what produced it (e.g. "sg-camera-sim true calibration")
+  std::string date;        ///< when, ISO 8601 (filled by write_calibration when empty)
 };
 
 /// The file format's version; read_calibration refuses other versions.

@@ -7,7 +7,11 @@ namespace sg::vision {
 CameraModel::CameraModel(int width, int height, const Intrinsics& intrinsics,
                          const Distortion& distortion, const Eigen::Matrix3d& R,
                          const Eigen::Vector3d& t)
-    : width_(width), height_(height), intrinsics_(intrinsics), distortion_(distortion), R_(R),
+    : width_(width),
+      height_(height),
+      intrinsics_(intrinsics),
+      distortion_(distortion),
+      R_(R),
       t_(t) {
   if (width <= 0 || height <= 0) throw std::invalid_argument("camera image size must be positive");
   if (!(intrinsics.fx > 0) || !(intrinsics.fy > 0))
@@ -20,7 +24,7 @@ CameraModel CameraModel::look_at(int width, int height, const Intrinsics& intrin
   const Eigen::Vector3d z = (target - eye).normalized();  // optical axis
   const Eigen::Vector3d x = z.cross(up).normalized();     // image right
   if (!x.allFinite()) throw std::invalid_argument("look_at: the optical axis is parallel to up");
-  const Eigen::Vector3d y = z.cross(x);                   // image down
+  const Eigen::Vector3d y = z.cross(x);  // image down
   Eigen::Matrix3d R;
   R.row(0) = x.transpose();
   R.row(1) = y.transpose();

@@ -2,7 +2,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-
 #include <optional>
 
 namespace sg::vision {

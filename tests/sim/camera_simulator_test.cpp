@@ -102,3 +102,30 @@ TEST(CameraSimulator, ConfigErrorsNameTheKey) {
 
 }  // namespace
 }  // namespace sg::sim
+
+namespace sg::sim {
+namespace {
+
+// config/stereograsp.yaml loads and says what the built-in defaults are.
+TEST(CameraSimulator, ShippedConfigMatchesDefaults) {
+  const SimParams shipped =
+      load_sim_params(Config::load(std::string(SG_SOURCE_DIR) + "/config/stereograsp.yaml"));
+  const SimParams defaults;
+  EXPECT_EQ(shipped.rig.target, defaults.rig.target);
+  EXPECT_DOUBLE_EQ(shipped.rig.baseline, defaults.rig.baseline);
+  EXPECT_NEAR(shipped.rig.toe_in, defaults.rig.toe_in, 1e-12);
+  EXPECT_NEAR(shipped.rig.pitch, defaults.rig.pitch, 1e-12);
+  EXPECT_DOUBLE_EQ(shipped.rig.intrinsics.fx, defaults.rig.intrinsics.fx);
+  EXPECT_DOUBLE_EQ(shipped.rig.intrinsics.cx, defaults.rig.intrinsics.cx);
+  EXPECT_EQ(shipped.scenario.kind, defaults.scenario.kind);
+  EXPECT_DOUBLE_EQ(shipped.scenario.radius, defaults.scenario.radius);
+  EXPECT_DOUBLE_EQ(shipped.scenario.drift_speed, defaults.scenario.drift_speed);
+  EXPECT_DOUBLE_EQ(shipped.lighting.gain_amplitude, defaults.lighting.gain_amplitude);
+  EXPECT_DOUBLE_EQ(shipped.frame_rate, defaults.frame_rate);
+  EXPECT_DOUBLE_EQ(shipped.noise_sigma, defaults.noise_sigma);
+  EXPECT_EQ(shipped.scene.distractors, defaults.scene.distractors);
+  EXPECT_TRUE(shipped.occlusion.episodes.empty());
+}
+
+}  // namespace
+}  // namespace sg::sim

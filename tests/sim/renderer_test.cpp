@@ -18,7 +18,8 @@ struct Ellipse {
 /// C = K^-T Q K^-1 with Q = X0 X0^T - (|X0|^2 - r^2) I. Centre and area follow from C.
 Ellipse sphere_image(const vision::CameraModel& cam, const Eigen::Vector3d& centre, double r) {
   const Eigen::Vector3d X0 = cam.to_camera(centre);
-  const Eigen::Matrix3d Q = X0 * X0.transpose() - (X0.squaredNorm() - r * r) * Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d Q =
+      X0 * X0.transpose() - (X0.squaredNorm() - r * r) * Eigen::Matrix3d::Identity();
   const Eigen::Matrix3d Kinv = cam.K().inverse();
   Eigen::Matrix3d C = Kinv.transpose() * Q * Kinv;
   Eigen::Matrix2d M = C.topLeftCorner<2, 2>();
@@ -62,7 +63,8 @@ TEST(Renderer, BallSilhouetteMatchesTheAnalyticEllipse) {
       const Ellipse truth = sphere_image(sim.camera(cam), p, 0.035);
       most_off_axis = std::max(most_off_axis, (truth.centre - *sim.camera(cam).project(p)).norm());
       const Ellipse rendered = moments(sim.renderer(cam).ball_coverage(p, 0.035));
-      EXPECT_LT((rendered.centre - truth.centre).norm(), 0.1) << "camera " << cam << " at " << p.transpose();
+      EXPECT_LT((rendered.centre - truth.centre).norm(), 0.1)
+          << "camera " << cam << " at " << p.transpose();
       EXPECT_NEAR(rendered.area / truth.area, 1.0, 0.02) << "camera " << cam;
       worst_centre = std::max(worst_centre, (rendered.centre - truth.centre).norm());
       worst_area = std::max(worst_area, std::abs(rendered.area / truth.area - 1.0));

@@ -24,7 +24,8 @@ TEST(Scenario, DriftIsATriangleWaveReversingEvery20s) {
   EXPECT_NEAR(triangle_drift(30, 0.01, 20), -0.1, 1e-15);
   EXPECT_NEAR(triangle_drift(50, 0.01, 20), 0.1, 1e-15);
   for (double t : {1.0, 12.0, 29.0, 31.0, 49.0, 51.0, 1234.5}) {  // speed is 0.01 m/s throughout
-    const double v = (triangle_drift(t + 1e-3, 0.01, 20) - triangle_drift(t - 1e-3, 0.01, 20)) / 2e-3;
+    const double v =
+        (triangle_drift(t + 1e-3, 0.01, 20) - triangle_drift(t - 1e-3, 0.01, 20)) / 2e-3;
     EXPECT_NEAR(std::abs(v), 0.01, 1e-9) << t;
   }
   EXPECT_GT(triangle_drift(9.9, 0.01, 20), triangle_drift(9.8, 0.01, 20));    // rising before 10
@@ -36,7 +37,8 @@ TEST(Scenario, PaperIsCirclePlusDrift) {
   const auto s = make_scenario(paper());
   const Eigen::Vector3d c(0.45, 0.0, 0.10);
   for (double t = 0; t < 200; t += 0.25) {
-    const Eigen::Vector3d on_circle = s->position(t) - c - Eigen::Vector3d(0, triangle_drift(t, 0.01, 20), 0);
+    const Eigen::Vector3d on_circle =
+        s->position(t) - c - Eigen::Vector3d(0, triangle_drift(t, 0.01, 20), 0);
     EXPECT_NEAR(on_circle.norm(), 0.15, 1e-12);
     EXPECT_NEAR(on_circle.z(), 0.0, 1e-15);
     EXPECT_NEAR(std::atan2(on_circle.y(), on_circle.x()),

@@ -3,9 +3,9 @@
 #include "vision/camera_model.hpp"
 
 #include <gtest/gtest.h>
+
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
-
 #include <random>
 
 namespace sg::vision {

@@ -1,0 +1,134 @@
+// sg-camera-sim as a process: frames and truth on the bus, videos and CSV on disk, bad input.
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+#include <thread>
+
+#include "common/bus.hpp"
+#include "common/message_types.hpp"
+#include "tests/integration/multicast_guard.hpp"
+#include "tests/support/subprocess.hpp"
+#include "vision/calibration_file.hpp"
+
+namespace sg::test {
+namespace {
+
+using namespace std::chrono_literals;
+
+// 12 stereo frames at 4 Hz arrive as JPEG CAMERA_LEFT/RIGHT and GROUND_TRUTH, with the same
+// capture times 0.25 s apart, decodable, and the truth seen by both cameras.
+TEST(CameraSim, PublishesFramesAndTruthOnTheBus) {
+  constexpr int kPort = 7906;
+  ASSERT_TRUE(multicast_available(kPort));
+  Bus bus(test_url(kPort));
+  std::vector<stereograsp::image_t> left, right;
+  std::vector<stereograsp::point3_t> truth;
+  bus.subscribe<stereograsp::image_t>("CAMERA_LEFT",
+                                      [&](const auto& m, const auto&) { left.push_back(m); });
+  bus.subscribe<stereograsp::image_t>("CAMERA_RIGHT",
+                                      [&](const auto& m, const auto&) { right.push_back(m); });
+  bus.subscribe<stereograsp::point3_t>("GROUND_TRUTH",
+                                       [&](const auto& m, const auto&) { truth.push_back(m); });
+  Child sim({program("sg-camera-sim"), "--rate", "4", "--fast", "--frames", "12", "--lcm-url",
+             test_url(kPort)});
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
+  while (truth.size() < 12 && std::chrono::steady_clock::now() < deadline) bus.handle(100ms);
+  while (bus.handle(200ms)) {
+  }
+  const ProcessResult done = sim.wait(30s);
+  EXPECT_EQ(done.exit_code, 0) << done.err;
+  ASSERT_EQ(left.size(), 12u);
+  ASSERT_EQ(right.size(), 12u);
+  ASSERT_EQ(truth.size(), 12u);
+  for (size_t k = 0; k < 12; ++k) {
+    EXPECT_EQ(left[k].utime, truth[k].utime);
+    EXPECT_EQ(right[k].utime, truth[k].utime);
+    EXPECT_EQ(left[k].frame_number, static_cast<int64_t>(k));
+    if (k > 0) {
+      EXPECT_EQ(truth[k].utime - truth[k - 1].utime, 250000);
+    }
+    EXPECT_EQ(left[k].pixel_format, stereograsp::image_t::FORMAT_JPEG);
+    EXPECT_EQ(truth[k].seen_by,
+              stereograsp::point3_t::SEEN_LEFT | stereograsp::point3_t::SEEN_RIGHT);
+  }
+  const cv::Mat decoded = cv::imdecode(left[3].data, cv::IMREAD_COLOR);
+  EXPECT_EQ(decoded.cols, 640);
+  EXPECT_EQ(decoded.rows, 480);
+}
+
+// --write gives two videos OpenCV reads back frame by frame, a CSV row per frame, and the true
+// calibration, which projects the CSV's ball centres to where the red is in the frames.
+TEST(CameraSim, WritesVideosTruthAndCalibration) {
+  const std::string dir = make_temp_dir() + "/run";
+  const ProcessResult r = run({program("sg-camera-sim"), "--write", dir, "--frames", "10", "--rate",
+                               "4", "--occlusion", "1.0:0.5"},
+                              120s);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream csv(dir + "/ground_truth.csv");
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line.rfind("frame,utime,time_s,x_m,y_m,z_m,seen_left,seen_right", 0), 0u) << line;
+  std::vector<std::vector<double>> rows;
+  while (std::getline(csv, line)) {
+    std::vector<double> row;
+    std::stringstream s(line);
+    std::string cell;
+    while (std::getline(s, cell, ',')) row.push_back(std::stod(cell));
+    rows.push_back(row);
+  }
+  ASSERT_EQ(rows.size(), 10u);
+  EXPECT_EQ(rows[4][6], 0.0) << "t = 1.0 s is occluded";
+  EXPECT_EQ(rows[0][6], 1.0);
+
+  const vision::StereoCalibration calibration = vision::read_calibration(dir + "/calibration.yaml");
+  cv::VideoCapture video(dir + "/left.avi");
+  ASSERT_TRUE(video.isOpened());
+  int frames = 0;
+  cv::Mat frame;
+  while (video.read(frame)) {
+    ASSERT_EQ(frame.size(), cv::Size(640, 480));
+    if (frames == 0) {  // the ball is where the calibration says: red around its projection
+      const auto px = calibration.left.project({rows[0][3], rows[0][4], rows[0][5]});
+      ASSERT_TRUE(px.has_value());
+      const cv::Vec3b bgr = frame.at<cv::Vec3b>(cvRound(px->y()), cvRound(px->x()));
+      EXPECT_GT(bgr[2], 120) << "red";
+      EXPECT_LT(bgr[1], 90);
+    }
+    ++frames;
+  }
+  EXPECT_EQ(frames, 10);
+  cv::VideoCapture right(dir + "/right.avi");
+  EXPECT_EQ(static_cast<int>(right.get(cv::CAP_PROP_FRAME_COUNT)), 10);
+}
+
+// --snapshot writes the stereo pair side by side.
+TEST(CameraSim, SnapshotIsAStereoPair) {
+  const std::string png = make_temp_dir() + "/pair.png";
+  const ProcessResult r = run({program("sg-camera-sim"), "--snapshot", png}, 60s);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const cv::Mat pair = cv::imread(png);
+  EXPECT_EQ(pair.size(), cv::Size(1280, 480));
+}
+
+// Bad input: one line, non-zero exit.
+TEST(CameraSim, BadInputIsOneLine) {
+  const std::string dir = make_temp_dir();
+  std::ofstream(dir + "/bad.yaml") << "scenario:\n  kind: spiral\n";
+  for (const auto& args : std::vector<std::vector<std::string>>{{"--config", dir + "/bad.yaml"},
+                                                                {"--occlusion", "5-2"},
+                                                                {"--rate", "-4"},
+                                                                {"--write", "/proc/no/such/dir"}}) {
+    std::vector<std::string> argv = {program("sg-camera-sim")};
+    argv.insert(argv.end(), args.begin(), args.end());
+    const ProcessResult r = run(argv, 60s);
+    EXPECT_NE(r.exit_code, 0) << args[0];
+    EXPECT_LT(r.exit_code, 128) << args[0] << " crashed";
+    EXPECT_EQ(count_lines(r.err), 1) << r.err;
+  }
+}
+
+}  // namespace
+}  // namespace sg::test
