@@ -59,6 +59,35 @@ TEST(CameraSim, PublishesFramesAndTruthOnTheBus) {
   EXPECT_EQ(decoded.rows, 480);
 }
 
+// The gripper's state on SIM_ARM_STATE reaches the simulator: a ball held by the gripper is where
+// the tool is, in GROUND_TRUTH.
+TEST(CameraSim, FollowsSimArmStateFromTheBus) {
+  constexpr int kPort = 7908;
+  ASSERT_TRUE(multicast_available(kPort));
+  Bus bus(test_url(kPort));
+  std::vector<stereograsp::point3_t> truth;
+  bus.subscribe<stereograsp::point3_t>("GROUND_TRUTH",
+                                       [&](const auto& m, const auto&) { truth.push_back(m); });
+  Child sim(
+      {program("sg-camera-sim"), "--rate", "10", "--frames", "40", "--lcm-url", test_url(kPort)});
+  stereograsp::sim_arm_state_t arm{};
+  arm.tool_position[0] = 0.40, arm.tool_position[1] = 0.10, arm.tool_position[2] = 0.30;
+  arm.tool_orientation[1] = M_PI;
+  arm.gripper_opening = 0.06;
+  arm.holding_object = 1;
+  const auto deadline = std::chrono::steady_clock::now() + 30s;
+  while (truth.size() < 40 && std::chrono::steady_clock::now() < deadline) {
+    bus.publish("SIM_ARM_STATE", arm);
+    bus.handle(50ms);
+  }
+  EXPECT_EQ(sim.wait(30s).exit_code, 0);
+  ASSERT_GE(truth.size(), 30u);
+  const stereograsp::point3_t& last = truth.back();
+  EXPECT_DOUBLE_EQ(last.position[0], 0.40);
+  EXPECT_DOUBLE_EQ(last.position[1], 0.10);
+  EXPECT_DOUBLE_EQ(last.position[2], 0.30);
+}
+
 // --write gives two videos OpenCV reads back frame by frame, a CSV row per frame, and the true
 // calibration, which projects the CSV's ball centres to where the red is in the frames.
 TEST(CameraSim, WritesVideosTruthAndCalibration) {

@@ -149,3 +149,30 @@ TEST(Renderer, GripperHidesTheBall) {
 
 }  // namespace
 }  // namespace sg::sim
+
+namespace sg::sim {
+namespace {
+
+// Motion blur smears a moving ball and leaves a still one as it was.
+TEST(Renderer, MotionBlurSmearsOnlyWhatMoves) {
+  SimParams sharp = quiet();
+  sharp.scenario.rpm = 20;  // fast enough to smear within 0.1 s
+  SimParams blurred = sharp;
+  blurred.exposure = 0.1;
+  blurred.motion_blur_samples = 6;
+  CameraSimulator a(sharp), b(blurred);
+  StereoFrame fa, fb;
+  a.render(5, {}, fa);
+  b.render(5, {}, fb);
+  EXPECT_GT(cv::norm(fa.image[0], fb.image[0], cv::NORM_L1), 2000.0);
+  EXPECT_NEAR(fb.visibility[0].silhouette_px / fa.visibility[0].silhouette_px, 1.0, 0.02)
+      << "blur spreads the ball's light, it does not add any";
+  sharp.scenario.kind = blurred.scenario.kind = "still";
+  CameraSimulator c(sharp), d(blurred);
+  c.render(5, {}, fa);
+  d.render(5, {}, fb);
+  EXPECT_LE(cv::norm(fa.image[0], fb.image[0], cv::NORM_INF), 1.0);
+}
+
+}  // namespace
+}  // namespace sg::sim
