@@ -1,0 +1,74 @@
+#include "vision/color_detector.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+namespace sg::vision {
+namespace {
+
+int64_t fixed(double v) { return std::llround(std::clamp(v, 0.0, 1.0) * 65536.0); }
+
+}  // namespace
+
+ColorDetector::ColorDetector(const ColorThresholds& t)
+    : t_(t),
+      r_lo_(fixed(t.r_min)),
+      r_hi_(fixed(t.r_max)),
+      g_lo_(fixed(t.g_min)),
+      g_hi_(fixed(t.g_max)),
+      b_lo_(fixed(t.b_min)),
+      b_hi_(fixed(t.b_max)),
+      min_sum_(std::max(1, t.min_intensity)) {
+  for (double v : {t.r_min, t.r_max, t.g_min, t.g_max, t.b_min, t.b_max}) {
+    if (!(v >= 0.0 && v <= 1.0)) throw std::invalid_argument("colour thresholds must be in [0, 1]");
+  }
+  if (t.r_min > t.r_max || t.g_min > t.g_max || t.b_min > t.b_max)
+    throw std::invalid_argument("colour thresholds: a minimum is above its maximum");
+}
+
+void ColorDetector::mask(const cv::Mat& bgr, const cv::Rect& roi, cv::Mat& out) const {
+  CV_Assert(bgr.type() == CV_8UC3);
+  out.create(roi.size(), CV_8U);
+  for (int y = 0; y < roi.height; ++y) {
+    const uint8_t* in = bgr.ptr<uint8_t>(roi.y + y) + 3 * roi.x;
+    uint8_t* o = out.ptr<uint8_t>(y);
+    for (int x = 0; x < roi.width; ++x, in += 3) o[x] = is_object(in) ? 255 : 0;
+  }
+}
+
+ColorThresholds ColorThresholds::learn(const cv::Mat& bgr, const cv::Rect& roi, double margin,
+                                       double keep) {
+  if (bgr.type() != CV_8UC3) throw std::invalid_argument("learn: the image must be 8-bit BGR");
+  const cv::Rect inside = roi & cv::Rect(0, 0, bgr.cols, bgr.rows);
+  if (inside.area() == 0) throw std::invalid_argument("learn: the region is outside the image");
+  std::vector<double> r, g, b;
+  int min_sum = 765;
+  for (int y = inside.y; y < inside.y + inside.height; ++y) {
+    for (int x = inside.x; x < inside.x + inside.width; ++x) {
+      const cv::Vec3b p = bgr.at<cv::Vec3b>(y, x);
+      const int sum = p[0] + p[1] + p[2];
+      if (sum == 0) continue;
+      b.push_back(p[0] / double(sum));
+      g.push_back(p[1] / double(sum));
+      r.push_back(p[2] / double(sum));
+      min_sum = std::min(min_sum, sum);
+    }
+  }
+  if (r.empty()) throw std::invalid_argument("learn: the region holds only black pixels");
+  auto range = [&](std::vector<double>& v, double& lo, double& hi) {
+    std::sort(v.begin(), v.end());
+    const double cut = (1.0 - keep) / 2;
+    lo = std::max(0.0, v[static_cast<size_t>(cut * (v.size() - 1))] - margin);
+    hi = std::min(1.0, v[static_cast<size_t>((1.0 - cut) * (v.size() - 1))] + margin);
+  };
+  ColorThresholds t;
+  range(r, t.r_min, t.r_max);
+  range(g, t.g_min, t.g_max);
+  range(b, t.b_min, t.b_max);
+  t.min_intensity = std::max(30, min_sum / 2);
+  return t;
+}
+
+}  // namespace sg::vision

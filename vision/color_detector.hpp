@@ -1,0 +1,52 @@
+#pragma once
+
+#include <cstdint>
+#include <opencv2/core.hpp>
+
+namespace sg::vision {
+
+/// The object's colour as ranges of normalized RGB (eq. 7): r = R/(R+G+B), g = G/(R+G+B),
+/// b = B/(R+G+B), each within [min, max], and R+G+B at least `min_intensity` (below it the
+/// chromaticity of a dark pixel is noise).
+struct ColorThresholds {
+  double r_min = 0.50, r_max = 1.0;
+  double g_min = 0.0, g_max = 0.25;
+  double b_min = 0.0, b_max = 0.25;
+  int min_intensity = 60;  ///< floor on R+G+B (0..765)
+
+  /// Ranges that hold the central `keep` fraction of a sample's pixels per band (so a highlight
+  /// or an edge pixel in the sample does not widen them), learned from the pixels of `bgr`
+  /// (CV_8UC3) inside `roi`, widened by `margin` on each side.
+  static ColorThresholds learn(const cv::Mat& bgr, const cv::Rect& roi, double margin = 0.04,
+                               double keep = 0.90);
+};
+
+/// The paper's threshold (eq. 8) on normalized RGB (eq. 7), in integer arithmetic with no
+/// division: r >= r_min  <=>  2^16 R >= round(2^16 r_min) (R+G+B).
+///
+///     ColorDetector red(thresholds);
+///     if (red.is_object(pixel)) ...     // pixel: const uint8_t* B, G, R
+class ColorDetector {
+ public:
+  explicit ColorDetector(const ColorThresholds& t);
+
+  bool is_object(const uint8_t* bgr) const {
+    const int64_t b = bgr[0], g = bgr[1], r = bgr[2];
+    const int64_t sum = b + g + r;
+    if (sum < min_sum_) return false;
+    return r * kOne >= r_lo_ * sum && r * kOne <= r_hi_ * sum && g * kOne >= g_lo_ * sum &&
+           g * kOne <= g_hi_ * sum && b * kOne >= b_lo_ * sum && b * kOne <= b_hi_ * sum;
+  }
+
+  /// A binary image (CV_8U, 255 for object) of the pixels of `bgr` inside `roi`.
+  void mask(const cv::Mat& bgr, const cv::Rect& roi, cv::Mat& out) const;
+
+  const ColorThresholds& thresholds() const { return t_; }
+
+ private:
+  static constexpr int64_t kOne = 1 << 16;
+  ColorThresholds t_;
+  int64_t r_lo_, r_hi_, g_lo_, g_hi_, b_lo_, b_hi_, min_sum_;
+};
+
+}  // namespace sg::vision
