@@ -48,7 +48,10 @@ int run_program(CLI::App& app, int argc, char** argv, const std::function<int()>
     if (!spdlog::get(name)) init_logging(name, "info");
     return body();
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "%s: error: %s\n", name.c_str(), e.what());
+    std::string what = e.what();  // one line, whatever a library put in its message
+    while (!what.empty() && (what.back() == '\n' || what.back() == ' ')) what.pop_back();
+    for (char& c : what) c = (c == '\n' || c == '\r') ? ' ' : c;
+    std::fprintf(stderr, "%s: error: %s\n", name.c_str(), what.c_str());
     return 1;
   }
 }

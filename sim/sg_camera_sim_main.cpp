@@ -24,6 +24,7 @@
 #include "common/shutdown.hpp"
 #include "sim/camera_simulator.hpp"
 #include "vision/calibration_file.hpp"
+#include "vision/image_message.hpp"
 
 namespace {
 
@@ -43,27 +44,6 @@ struct Options {
   int64_t seed = -1;
   std::vector<std::string> occlusions;
 };
-
-stereograsp::image_t to_image_t(const cv::Mat& bgr, int8_t camera, int64_t frame, int64_t utime,
-                                bool jpeg, int quality) {
-  stereograsp::image_t msg{};
-  msg.utime = utime;
-  msg.camera = camera;
-  msg.frame_number = frame;
-  msg.width = bgr.cols;
-  msg.height = bgr.rows;
-  if (jpeg) {
-    msg.pixel_format = stereograsp::image_t::FORMAT_JPEG;
-    msg.row_stride = 0;
-    cv::imencode(".jpg", bgr, msg.data, {cv::IMWRITE_JPEG_QUALITY, quality});
-  } else {
-    msg.pixel_format = stereograsp::image_t::FORMAT_BGR8;
-    msg.row_stride = bgr.cols * 3;
-    msg.data.assign(bgr.data, bgr.data + bgr.total() * 3);  // rendered images are continuous
-  }
-  msg.size = static_cast<int32_t>(msg.data.size());
-  return msg;
-}
 
 stereograsp::point3_t ground_truth(const sg::sim::StereoFrame& f, int64_t utime) {
   stereograsp::point3_t p{};
@@ -170,10 +150,11 @@ int run_bus(sg::sim::CameraSimulator& sim, const Options& o, int64_t frames, boo
     // Capture time: the frame's place on the timeline (real time, or simulated with --fast).
     const int64_t utime = start_utime + k * period_us;
     sim.render(k, arm, frame);
-    bus.publish("CAMERA_LEFT", to_image_t(frame.image[0], stereograsp::image_t::LEFT, k, utime,
-                                          jpeg, o.jpeg_quality));
-    bus.publish("CAMERA_RIGHT", to_image_t(frame.image[1], stereograsp::image_t::RIGHT, k, utime,
-                                           jpeg, o.jpeg_quality));
+    bus.publish("CAMERA_LEFT", sg::vision::encode_image(frame.image[0], stereograsp::image_t::LEFT,
+                                                        k, utime, jpeg, o.jpeg_quality));
+    bus.publish("CAMERA_RIGHT",
+                sg::vision::encode_image(frame.image[1], stereograsp::image_t::RIGHT, k, utime,
+                                         jpeg, o.jpeg_quality));
     bus.publish("GROUND_TRUTH", ground_truth(frame, utime));
   }
   const double seconds = duration<double>(steady_clock::now() - start).count();

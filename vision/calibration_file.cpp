@@ -103,7 +103,7 @@ void write_calibration(const std::string& path, const StereoCalibration& c) {
     fs.release();
   } catch (const cv::Exception& e) {
     std::remove(temporary.c_str());
-    throw CalibrationError(path + ": cannot write calibration file: " + e.msg);
+    throw CalibrationError(path + ": cannot write calibration file: " + e.err);
   }
   std::error_code error;
   std::filesystem::rename(temporary, path, error);
@@ -119,7 +119,7 @@ StereoCalibration read_calibration(const std::string& path) {
     if (!fs.open(path, cv::FileStorage::READ))
       throw CalibrationError(path + ": cannot open calibration file");
   } catch (const cv::Exception& e) {
-    throw CalibrationError(path + ": not a valid calibration file (" + e.msg + ")");
+    throw CalibrationError(path + ": not a valid calibration file (" + e.err + ")");
   }
   const cv::FileNode version = fs["format_version"];
   if (version.empty() || !version.isInt())

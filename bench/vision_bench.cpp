@@ -1,0 +1,131 @@
+// The vision stage per stereo pair (640x480, a ball about 40 px across, the simulated lab's
+// cluttered background): tracking mode (search window), full-frame mode, and in the same run a
+// straightforward OpenCV pipeline (whole-image normalization, inRange,
+// connectedComponentsWithStats, moments) as the baseline. Prints the table and the ratios.
+//
+//   build/bin/vision_bench
+// Goals (issue 4): tracking <= 100 us a pair (median), full frame <= 2 ms a pair, tracking at least
+// 10x faster than the baseline.
+
+#include <benchmark/benchmark.h>
+
+#include <map>
+#include <opencv2/imgproc.hpp>
+
+#include "sim/camera_simulator.hpp"
+#include "vision/blob_tracker.hpp"
+
+namespace {
+
+/// A stereo pair with the ball about 40 px across: the paper's rig seen from farther away.
+const std::array<cv::Mat, 2>& frames() {
+  static const std::array<cv::Mat, 2> pair = [] {
+    sg::sim::SimParams p;
+    p.rig.intrinsics.fx = p.rig.intrinsics.fy = 280;  // ~40 px ball at the rig's distance
+    sg::sim::CameraSimulator sim(p);
+    sg::sim::StereoFrame f;
+    sim.render(10, {}, f);
+    return f.image;
+  }();
+  return pair;
+}
+
+void BM_Pair_Tracking(benchmark::State& state) {
+  const auto& pair = frames();
+  std::array<sg::vision::BlobTracker, 2> trackers{sg::vision::BlobTracker({}, pair[0].size()),
+                                                  sg::vision::BlobTracker({}, pair[0].size())};
+  for (int i = 0; i < 2; ++i) trackers[static_cast<size_t>(i)].track(pair[static_cast<size_t>(i)]);
+  for (auto _ : state) {
+    for (int i = 0; i < 2; ++i) {
+      const auto o = trackers[static_cast<size_t>(i)].track(pair[static_cast<size_t>(i)]);
+      if (!o.found || !o.tracking) state.SkipWithError("lost the ball");
+    }
+  }
+}
+BENCHMARK(BM_Pair_Tracking)->Unit(benchmark::kMicrosecond)->Repetitions(5)->ReportAggregatesOnly();
+
+void BM_Pair_FullFrame(benchmark::State& state) {
+  const auto& pair = frames();
+  std::array<sg::vision::BlobTracker, 2> trackers{sg::vision::BlobTracker({}, pair[0].size()),
+                                                  sg::vision::BlobTracker({}, pair[0].size())};
+  for (auto _ : state) {
+    for (int i = 0; i < 2; ++i) {
+      trackers[static_cast<size_t>(i)].reset();
+      if (!trackers[static_cast<size_t>(i)].track(pair[static_cast<size_t>(i)]).found)
+        state.SkipWithError("no ball");
+    }
+  }
+}
+BENCHMARK(BM_Pair_FullFrame)->Unit(benchmark::kMicrosecond)->Repetitions(5)->ReportAggregatesOnly();
+
+/// The baseline: normalize the whole image, threshold each band, label, take the largest region's
+/// moments.
+void BM_Pair_OpenCvBaseline(benchmark::State& state) {
+  const auto& pair = frames();
+  const sg::vision::ColorThresholds t;
+  cv::Mat f, sum, norm, mask, labels, stats, centroids;
+  for (auto _ : state) {
+    for (const cv::Mat& image : pair) {
+      image.convertTo(f, CV_32FC3);
+      cv::transform(f, sum, cv::Matx13f(1, 1, 1));
+      std::vector<cv::Mat> bands;
+      cv::split(f, bands);
+      for (cv::Mat& b : bands) cv::divide(b, sum + 1e-6f, b);
+      cv::merge(bands, norm);
+      cv::inRange(norm, cv::Scalar(t.b_min, t.g_min, t.r_min),
+                  cv::Scalar(t.b_max, t.g_max, t.r_max), mask);
+      cv::Mat bright;
+      cv::compare(sum, t.min_intensity, bright, cv::CMP_GE);
+      mask &= bright;
+      const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8);
+      int best = 0;
+      for (int i = 1; i < n; ++i) {
+        if (best == 0 || stats.at<int>(i, cv::CC_STAT_AREA) > stats.at<int>(best, cv::CC_STAT_AREA))
+          best = i;
+      }
+      if (best == 0) state.SkipWithError("no ball");
+      const cv::Moments m = cv::moments(labels == best, true);
+      benchmark::DoNotOptimize(m.m10);
+    }
+  }
+}
+BENCHMARK(BM_Pair_OpenCvBaseline)
+    ->Unit(benchmark::kMicrosecond)
+    ->Repetitions(5)
+    ->ReportAggregatesOnly();
+
+/// Keeps the medians and prints the ratios after the table.
+class RatioReporter : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    for (const Run& run : runs) {
+      if (run.aggregate_name == "median")
+        median_us_[run.run_name.function_name] = run.GetAdjustedRealTime();
+    }
+    ConsoleReporter::ReportRuns(runs);
+  }
+  void PrintRatios() const {
+    const double base = median_us_.at("BM_Pair_OpenCvBaseline");
+    std::printf("\nper stereo pair (median)   time        vs OpenCV baseline   goal\n");
+    std::printf("  tracking mode        %8.1f us    %6.1fx faster       <= 100 us, >= 10x\n",
+                median_us_.at("BM_Pair_Tracking"), base / median_us_.at("BM_Pair_Tracking"));
+    std::printf("  full frame           %8.1f us    %6.1fx faster       <= 2000 us\n",
+                median_us_.at("BM_Pair_FullFrame"), base / median_us_.at("BM_Pair_FullFrame"));
+    std::printf("  OpenCV baseline      %8.1f us\n", base);
+  }
+
+ private:
+  std::map<std::string, double> median_us_;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  RatioReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  reporter.PrintRatios();
+  benchmark::Shutdown();
+  return 0;
+}

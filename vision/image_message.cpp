@@ -1,0 +1,101 @@
+#include "vision/image_message.hpp"
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace sg::vision {
+
+using stereograsp::image_t;
+
+image_t encode_image(const cv::Mat& bgr, int8_t camera, int64_t frame_number, int64_t utime,
+                     bool jpeg, int jpeg_quality) {
+  image_t msg{};
+  msg.utime = utime;
+  msg.camera = camera;
+  msg.frame_number = frame_number;
+  msg.width = bgr.cols;
+  msg.height = bgr.rows;
+  if (jpeg) {
+    msg.pixel_format = image_t::FORMAT_JPEG;
+    cv::imencode(".jpg", bgr, msg.data, {cv::IMWRITE_JPEG_QUALITY, jpeg_quality});
+  } else {
+    msg.pixel_format = image_t::FORMAT_BGR8;
+    msg.row_stride = bgr.cols * 3;
+    const cv::Mat continuous = bgr.isContinuous() ? bgr : bgr.clone();
+    msg.data.assign(continuous.data, continuous.data + continuous.total() * 3);
+  }
+  msg.size = static_cast<int32_t>(msg.data.size());
+  return msg;
+}
+
+std::optional<cv::Mat> decode_image(const image_t& m, std::string* error) {
+  auto fail = [&](const std::string& what) -> std::optional<cv::Mat> {
+    if (error) *error = what;
+    return std::nullopt;
+  };
+  if (m.width <= 0 || m.height <= 0 || m.width > 16384 || m.height > 16384)
+    return fail("image size " + std::to_string(m.width) + "x" + std::to_string(m.height) +
+                " is not valid");
+  if (m.size != static_cast<int32_t>(m.data.size()))
+    return fail("size field does not match the data");
+  if (m.pixel_format == image_t::FORMAT_JPEG) {
+    cv::Mat bgr = cv::imdecode(m.data, cv::IMREAD_COLOR);
+    if (bgr.empty()) return fail("JPEG data does not decode");
+    if (bgr.cols != m.width || bgr.rows != m.height)
+      return fail("JPEG size differs from width x height");
+    return bgr;
+  }
+  const int channels =
+      m.pixel_format == image_t::FORMAT_GRAY8                                              ? 1
+      : (m.pixel_format == image_t::FORMAT_BGR8 || m.pixel_format == image_t::FORMAT_RGB8) ? 3
+                                                                                           : 0;
+  if (channels == 0) return fail("unknown pixel_format " + std::to_string(m.pixel_format));
+  if (m.row_stride < m.width * channels ||
+      static_cast<int64_t>(m.row_stride) * m.height > static_cast<int64_t>(m.data.size())) {
+    return fail(std::to_string(m.width) + "x" + std::to_string(m.height) + " with row_stride " +
+                std::to_string(m.row_stride) + " needs more than the " +
+                std::to_string(m.data.size()) + " bytes it holds");
+  }
+  const cv::Mat view(m.height, m.width, channels == 1 ? CV_8U : CV_8UC3,
+                     const_cast<uint8_t*>(m.data.data()), static_cast<size_t>(m.row_stride));
+  cv::Mat bgr;
+  if (m.pixel_format == image_t::FORMAT_GRAY8)
+    cv::cvtColor(view, bgr, cv::COLOR_GRAY2BGR);
+  else if (m.pixel_format == image_t::FORMAT_RGB8)
+    cv::cvtColor(view, bgr, cv::COLOR_RGB2BGR);
+  else
+    bgr = view.clone();
+  return bgr;
+}
+
+stereograsp::blob_t to_blob_t(const Observation& o, int8_t camera, int64_t frame_number,
+                              int64_t utime) {
+  stereograsp::blob_t b{};
+  b.utime = utime;
+  b.camera = camera;
+  b.frame_number = frame_number;
+  b.found = o.found;
+  b.mode = o.tracking ? stereograsp::blob_t::MODE_TRACKING : stereograsp::blob_t::MODE_FULL_FRAME;
+  const Blob& blob = o.blob;
+  b.centroid[0] = blob.centroid.x, b.centroid[1] = blob.centroid.y;
+  b.area = blob.area;
+  b.major_axis = blob.major_axis;
+  b.minor_axis = blob.minor_axis;
+  b.orientation = blob.orientation;
+  for (int i = 0; i < 2; ++i) {
+    b.major_axis_ends[i][0] = blob.major_axis_ends[static_cast<size_t>(i)].x;
+    b.major_axis_ends[i][1] = blob.major_axis_ends[static_cast<size_t>(i)].y;
+    b.minor_axis_ends[i][0] = blob.minor_axis_ends[static_cast<size_t>(i)].x;
+    b.minor_axis_ends[i][1] = blob.minor_axis_ends[static_cast<size_t>(i)].y;
+  }
+  b.bounding_box[0] = blob.bounding_box.x, b.bounding_box[1] = blob.bounding_box.y;
+  b.bounding_box[2] = blob.bounding_box.x + blob.bounding_box.width;
+  b.bounding_box[3] = blob.bounding_box.y + blob.bounding_box.height;
+  b.search_window[0] = o.window.x, b.search_window[1] = o.window.y;
+  b.search_window[2] = o.window.width, b.search_window[3] = o.window.height;
+  b.num_regions = o.num_regions;
+  b.misses = o.misses;
+  return b;
+}
+
+}  // namespace sg::vision

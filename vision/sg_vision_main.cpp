@@ -1,0 +1,330 @@
+// sg-vision: finds the red ball in both cameras (sections 5.1-5.3) and, with a calibration,
+// places it in 3D (section 5.4). Publishes BLOB_LEFT, BLOB_RIGHT for every stereo frame and
+// OBJECT_POSITION when --calibration is given.
+//
+//   sg-vision --calibration cams.yaml                      # frames from CAMERA_LEFT/RIGHT (sim,
+//   log) sg-vision --source video --left l.avi --right r.avi    # two video files sg-vision
+//   --source images --left dirL --right dirR     # two folders of images, by name sg-vision
+//   --source v4l2 --left /dev/video0 --right /dev/video1 --publish-images sg-vision learn-color
+//   frame.png --roi 300,200,20,20    # colour ranges for config
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+#include <thread>
+
+#include "common/bus.hpp"
+#include "common/clock.hpp"
+#include "common/program.hpp"
+#include "common/shutdown.hpp"
+#include "vision/blob_tracker.hpp"
+#include "vision/calibration_file.hpp"
+#include "vision/image_message.hpp"
+#include "vision/stereo_pairer.hpp"
+#include "vision/triangulation.hpp"
+#include "vision/vision_config.hpp"
+
+namespace {
+
+using namespace std::chrono;
+namespace fs = std::filesystem;
+using stereograsp::blob_t;
+using stereograsp::image_t;
+using stereograsp::point3_t;
+
+struct Options {
+  std::string source = "lcm";
+  std::string left, right;
+  std::string calibration;
+  double rate_hz = 0;  // files: pace to this rate (0: as fast as possible)
+  int width = 640, height = 480;
+  double fps = 30;
+  bool publish_images = false;
+  int64_t max_frames = 0;
+  double pair_tolerance_ms = 5.0;
+};
+
+/// Tracks both cameras of each stereo pair and publishes what it found.
+class StereoVision {
+ public:
+  StereoVision(sg::Bus& bus, const sg::vision::BlobTracker::Params& params, cv::Size size,
+               std::optional<sg::vision::StereoCalibration> calibration, bool publish_images)
+      : bus_(bus),
+        trackers_{sg::vision::BlobTracker(params, size), sg::vision::BlobTracker(params, size)},
+        size_(size),
+        calibration_(std::move(calibration)),
+        publish_images_(publish_images) {}
+
+  void process(const cv::Mat& left, const cv::Mat& right, int64_t frame_number, int64_t utime) {
+    const cv::Mat* images[2] = {&left, &right};
+    sg::vision::Observation o[2];
+    for (int i = 0; i < 2; ++i) {
+      if (images[i]->size() != size_) {
+        reset_size(images[i]->size());
+      }
+      if (publish_images_) {
+        bus_.publish(i == 0 ? "CAMERA_LEFT" : "CAMERA_RIGHT",
+                     sg::vision::encode_image(*images[i], static_cast<int8_t>(i), frame_number,
+                                              utime, true));
+      }
+      o[i] = trackers_[i].track(*images[i]);
+      found_[i] += o[i].found;
+      tracking_[i] += o[i].tracking;
+      bus_.publish(i == 0 ? "BLOB_LEFT" : "BLOB_RIGHT",
+                   sg::vision::to_blob_t(o[i], static_cast<int8_t>(i), frame_number, utime));
+    }
+    ++pairs_;
+    if (calibration_) publish_position(o, utime);
+  }
+
+  void report(uint64_t unmatched, uint64_t bad_images) const {
+    auto pct = [&](uint64_t n) {
+      return pairs_ ? 100.0 * static_cast<double>(n) / static_cast<double>(pairs_) : 0.0;
+    };
+    std::printf(
+        "processed %llu stereo frames: ball found left %.1f%%, right %.1f%%; tracking mode "
+        "left %.1f%%, right %.1f%%; %llu unmatched frames, %llu bad images\n",
+        static_cast<unsigned long long>(pairs_), pct(found_[0]), pct(found_[1]), pct(tracking_[0]),
+        pct(tracking_[1]), static_cast<unsigned long long>(unmatched),
+        static_cast<unsigned long long>(bad_images));
+  }
+
+ private:
+  void reset_size(cv::Size size) {
+    spdlog::warn("frame size changed to {}x{}: tracking restarts", size.width, size.height);
+    size_ = size;
+    trackers_ = {sg::vision::BlobTracker(trackers_[0].params(), size),
+                 sg::vision::BlobTracker(trackers_[1].params(), size)};
+  }
+
+  void publish_position(const sg::vision::Observation o[2], int64_t utime) {
+    point3_t p{};
+    p.utime = utime;
+    p.seen_by = static_cast<int8_t>((o[0].found ? point3_t::SEEN_LEFT : 0) |
+                                    (o[1].found ? point3_t::SEEN_RIGHT : 0));
+    p.visible = o[0].found && o[1].found;
+    const double nan = std::nan("");
+    for (int i = 0; i < 3; ++i) p.position[i] = p.position_sigma[i] = nan;
+    p.reprojection_error = nan;
+    if (p.visible) {
+      const auto t = sg::vision::triangulate_linear(
+          calibration_->left, {o[0].blob.centroid.x, o[0].blob.centroid.y}, calibration_->right,
+          {o[1].blob.centroid.x, o[1].blob.centroid.y});
+      for (int i = 0; i < 3; ++i) p.position[i] = t.position[i];
+      p.reprojection_error = t.reprojection_error;
+      if (t.behind_camera) p.flags |= point3_t::FLAG_BEHIND_CAMERA;
+      if (t.reprojection_error > 3.0) p.flags |= point3_t::FLAG_LARGE_RESIDUAL;
+    }
+    bus_.publish("OBJECT_POSITION", p);
+  }
+
+  sg::Bus& bus_;
+  std::array<sg::vision::BlobTracker, 2> trackers_;
+  cv::Size size_;
+  std::optional<sg::vision::StereoCalibration> calibration_;
+  bool publish_images_;
+  uint64_t pairs_ = 0, found_[2] = {0, 0}, tracking_[2] = {0, 0};
+};
+
+int run_lcm(sg::Bus& bus, StereoVision& vision, const Options& o) {
+  uint64_t bad = 0;
+  int64_t frames = 0;
+  sg::vision::StereoPairer<cv::Mat> pairer(std::llround(o.pair_tolerance_ms * 1000));
+  int64_t frame_number = 0;
+  auto on_image = [&](const image_t& m, const sg::ReceiveInfo& info) {
+    std::string error;
+    const auto image = sg::vision::decode_image(m, &error);
+    if (!image) {
+      if (++bad <= 10 || bad % 1000 == 0)
+        spdlog::warn("{}: dropped an image: {} ({} so far)", info.channel, error, bad);
+      return;
+    }
+    const int side = info.channel == "CAMERA_LEFT" ? 0 : 1;
+    if (side == 0) frame_number = m.frame_number;
+    if (auto pair = pairer.add(side, m.utime, *image)) {
+      vision.process(pair->first, pair->second, frame_number, m.utime);
+      ++frames;
+    }
+  };
+  bus.subscribe<image_t>("CAMERA_LEFT", on_image);
+  bus.subscribe<image_t>("CAMERA_RIGHT", on_image);
+  spdlog::info("waiting for CAMERA_LEFT and CAMERA_RIGHT");
+  bus.spin([&] { return o.max_frames == 0 || frames < o.max_frames; });
+  vision.report(pairer.unmatched(), bad + bus.decode_errors());
+  return 0;
+}
+
+/// Frames from two video files, two folders of images, or two V4L2 cameras.
+class FrameSource {
+ public:
+  explicit FrameSource(const Options& o) : o_(o) {
+    if (o.left.empty() || o.right.empty())
+      throw std::runtime_error("--left and --right are required for --source " + o.source);
+    if (o.source == "images") {
+      files_[0] = list_images(o.left);
+      files_[1] = list_images(o.right);
+      if (files_[0].size() != files_[1].size())
+        throw std::runtime_error("--left has " + std::to_string(files_[0].size()) +
+                                 " images but --right has " + std::to_string(files_[1].size()));
+      return;
+    }
+    for (int i = 0; i < 2; ++i) {
+      const std::string& name = i == 0 ? o.left : o.right;
+      if (o.source == "v4l2") {
+        capture_[i].open(name, cv::CAP_V4L2);
+        if (capture_[i].isOpened()) {
+          capture_[i].set(cv::CAP_PROP_FRAME_WIDTH, o.width);
+          capture_[i].set(cv::CAP_PROP_FRAME_HEIGHT, o.height);
+          capture_[i].set(cv::CAP_PROP_FPS, o.fps);
+        }
+      } else {
+        if (!fs::exists(name)) throw std::runtime_error(name + ": no such video file");
+        capture_[i].open(name);
+      }
+      if (!capture_[i].isOpened())
+        throw std::runtime_error(name + ": cannot open (unplugged camera, or not a video?)");
+    }
+  }
+
+  /// The next pair; false at the end (or after a camera stops answering).
+  bool next(cv::Mat& left, cv::Mat& right) {
+    if (o_.source == "images") {
+      if (index_ >= files_[0].size()) return false;
+      left = read(files_[0][index_]);
+      right = read(files_[1][index_]);
+      ++index_;
+      return true;
+    }
+    // Grab both, then retrieve both, so the two exposures are as close as the driver allows.
+    for (int attempt = 0; attempt < 5; ++attempt) {
+      if (capture_[0].grab() && capture_[1].grab() && capture_[0].retrieve(left) &&
+          capture_[1].retrieve(right) && !left.empty() && !right.empty()) {
+        return true;
+      }
+      if (o_.source != "v4l2") return false;  // a file ended
+      spdlog::warn("a camera did not deliver a frame (attempt {} of 5)", attempt + 1);
+      std::this_thread::sleep_for(milliseconds(100));
+    }
+    throw std::runtime_error("the cameras stopped delivering frames (unplugged?)");
+  }
+
+  bool live() const { return o_.source == "v4l2"; }
+
+ private:
+  static std::vector<std::string> list_images(const std::string& dir) {
+    if (!fs::is_directory(dir)) throw std::runtime_error(dir + ": not a folder of images");
+    std::vector<std::string> files;
+    for (const auto& entry : fs::directory_iterator(dir)) {
+      std::string ext = entry.path().extension().string();
+      std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+      if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".ppm")
+        files.push_back(entry.path());
+    }
+    std::sort(files.begin(), files.end());
+    if (files.empty()) throw std::runtime_error(dir + ": holds no images (png, jpg, bmp, ppm)");
+    return files;
+  }
+  static cv::Mat read(const std::string& path) {
+    cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);
+    if (image.empty()) throw std::runtime_error(path + ": cannot read the image");
+    return image;
+  }
+
+  Options o_;
+  cv::VideoCapture capture_[2];
+  std::vector<std::string> files_[2];
+  size_t index_ = 0;
+};
+
+int run_frames(StereoVision& vision, const Options& o) {
+  FrameSource source(o);
+  const int64_t start_utime = sg::now_utime();
+  const auto start = steady_clock::now();
+  const double rate = o.rate_hz > 0 ? o.rate_hz : o.fps;
+  cv::Mat left, right;
+  int64_t k = 0;
+  for (; (o.max_frames == 0 || k < o.max_frames) && !sg::shutdown_requested(); ++k) {
+    if (o.rate_hz > 0)
+      std::this_thread::sleep_until(start + microseconds(std::llround(k * 1e6 / o.rate_hz)));
+    if (!source.next(left, right)) break;
+    // Capture time: the clock for live cameras, the frame's place in the recording for files.
+    const int64_t utime =
+        source.live() ? sg::now_utime() : start_utime + std::llround(k * 1e6 / rate);
+    vision.process(left, right, k, utime);
+  }
+  vision.report(0, 0);
+  return 0;
+}
+
+int learn_color(const std::string& image_path, const std::string& roi_text) {
+  const cv::Mat image = cv::imread(image_path, cv::IMREAD_COLOR);
+  if (image.empty()) throw std::runtime_error(image_path + ": cannot read the image");
+  int x, y, w, h;
+  char c1, c2, c3;
+  std::istringstream in(roi_text);
+  if (!(in >> x >> c1 >> y >> c2 >> w >> c3 >> h) || c1 != ',' || c2 != ',' || c3 != ',' ||
+      w <= 0 || h <= 0)
+    throw std::runtime_error("--roi '" + roi_text + "': expected x,y,w,h in pixels");
+  const auto t = sg::vision::ColorThresholds::learn(image, cv::Rect(x, y, w, h));
+  std::printf("# learned by: sg-vision learn-color %s --roi %s\nvision:\n", image_path.c_str(),
+              roi_text.c_str());
+  std::printf("  r_range: [%.3f, %.3f]\n  g_range: [%.3f, %.3f]\n  b_range: [%.3f, %.3f]\n",
+              t.r_min, t.r_max, t.g_min, t.g_max, t.b_min, t.b_max);
+  std::printf("  min_intensity: %d\n", t.min_intensity);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Finds the red ball in both cameras and places it in 3D.", "sg-vision"};
+  sg::CommonOptions common;
+  sg::add_common_options(app, common);
+  Options o;
+  app.add_option("--source", o.source, "lcm (CAMERA_LEFT/RIGHT), video, images or v4l2")
+      ->check(CLI::IsMember({"lcm", "video", "images", "v4l2"}));
+  app.add_option("--left", o.left, "left video file, image folder or V4L2 device");
+  app.add_option("--right", o.right, "right video file, image folder or V4L2 device");
+  app.add_option("--calibration", o.calibration,
+                 "stereo calibration file: also publish OBJECT_POSITION");
+  app.add_option("--rate", o.rate_hz,
+                 "files: frames per second to pace to (default: as fast as possible)");
+  app.add_option("--fps", o.fps,
+                 "files: frame rate of the recording (capture times); v4l2: rate to ask");
+  app.add_option("--width", o.width, "v4l2: image width");
+  app.add_option("--height", o.height, "v4l2: image height");
+  app.add_flag("--publish-images", o.publish_images,
+               "republish captured frames as JPEG CAMERA_LEFT/RIGHT");
+  app.add_option("--frames", o.max_frames, "stop after this many stereo frames (0: no limit)");
+  app.add_option("--pair-tolerance-ms", o.pair_tolerance_ms,
+                 "lcm: largest utime difference within a pair");
+  std::string learn_image, learn_roi;
+  CLI::App* learn =
+      app.add_subcommand("learn-color", "Print colour ranges learned from a sample of the ball");
+  learn->add_option("IMAGE", learn_image, "an image with the ball")->required();
+  learn->add_option("--roi", learn_roi, "x,y,w,h of a region inside the ball")->required();
+
+  return sg::run_program(app, argc, argv, [&] {
+    const sg::Config config = sg::load_common(common);
+    if (*learn) return learn_color(learn_image, learn_roi);
+    const auto params = sg::vision::load_tracker_params(config);
+    if (o.calibration.empty()) o.calibration = config.get<std::string>("vision.calibration", "");
+    std::optional<sg::vision::StereoCalibration> calibration;
+    if (!o.calibration.empty()) calibration = sg::vision::read_calibration(o.calibration);
+    if (o.publish_images && o.source == "lcm")
+      throw std::runtime_error(
+          "--publish-images republishes frames from cameras or files, not from the bus");
+    sg::install_shutdown_handlers();
+    sg::Bus bus(common.lcm_url);
+    const cv::Size size = calibration
+                              ? cv::Size(calibration->left.width(), calibration->left.height())
+                              : cv::Size(o.width, o.height);
+    StereoVision vision(bus, params, size, calibration, o.publish_images);
+    return o.source == "lcm" ? run_lcm(bus, vision, o) : run_frames(vision, o);
+  });
+}
