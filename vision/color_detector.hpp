@@ -9,9 +9,9 @@ namespace sg::vision {
 /// b = B/(R+G+B), each within [min, max], and R+G+B at least `min_intensity` (below it the
 /// chromaticity of a dark pixel is noise).
 struct ColorThresholds {
-  double r_min = 0.50, r_max = 1.0;
-  double g_min = 0.0, g_max = 0.25;
-  double b_min = 0.0, b_max = 0.25;
+  double r_min = 0.40, r_max = 1.0;
+  double g_min = 0.0, g_max = 0.30;
+  double b_min = 0.0, b_max = 0.30;
   int min_intensity = 60;  ///< floor on R+G+B (0..765)
 
   /// Ranges that hold the central `keep` fraction of a sample's pixels per band (so a highlight

@@ -63,7 +63,8 @@ class StereoVision {
   void process(const cv::Mat& left, const cv::Mat& right, int64_t frame_number, int64_t utime) {
     const cv::Mat* images[2] = {&left, &right};
     sg::vision::Observation o[2];
-    for (int i = 0; i < 2; ++i) {
+    for (int i = 0; i < 2; ++i) {  // track both, then publish: the position first, so that a
+                                   // viewer drawing on the blobs has the frame's position too
       if (images[i]->size() != size_) {
         reset_size(images[i]->size());
       }
@@ -75,11 +76,13 @@ class StereoVision {
       o[i] = trackers_[i].track(*images[i]);
       found_[i] += o[i].found;
       tracking_[i] += o[i].tracking;
-      bus_.publish(i == 0 ? "BLOB_LEFT" : "BLOB_RIGHT",
-                   sg::vision::to_blob_t(o[i], static_cast<int8_t>(i), frame_number, utime));
     }
     ++pairs_;
     if (calibration_) publish_position(o, utime);
+    for (int i = 0; i < 2; ++i) {
+      bus_.publish(i == 0 ? "BLOB_LEFT" : "BLOB_RIGHT",
+                   sg::vision::to_blob_t(o[i], static_cast<int8_t>(i), frame_number, utime));
+    }
   }
 
   void report(uint64_t unmatched, uint64_t bad_images) const {

@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <map>
+#include <opencv2/videoio.hpp>
 #include <thread>
 
 #include "common/bus.hpp"
@@ -90,6 +92,64 @@ TEST(Vision, VideoFilesSource) {
   EXPECT_NE(v.out.find("processed 20 stereo frames: ball found left 100.0%, right 100.0%"),
             std::string::npos)
       << v.out;
+}
+
+/// Fraction of the pixels along a rectangle's top and bottom edges that are yellow.
+double yellow_on_edges(const cv::Mat& frame, const cv::Rect& r) {
+  int yellow = 0, total = 0;
+  for (int y : {r.y, r.y + r.height - 1}) {  // cv::rectangle draws the last row at y + h - 1
+    for (int x = r.x + 4; x < r.x + r.width - 4; ++x) {
+      if (y < 0 || y >= frame.rows || x < 0 || x >= frame.cols) continue;
+      const cv::Vec3b p = frame.at<cv::Vec3b>(y, x);
+      yellow += p[2] > 170 && p[1] > 170 && p[0] < 110;
+      ++total;
+    }
+  }
+  return total ? double(yellow) / total : 0.0;
+}
+
+// sg-viewer --record: every recorded frame shows the yellow search window where the blob's was.
+TEST(Viewer, RecordedViewShowsTheSearchWindowWhereTheBlobWas) {
+  constexpr int kPort = 7911;
+  ASSERT_TRUE(multicast_available(kPort));
+  const std::string url = test_url(kPort);
+  const std::string dir = make_temp_dir();
+  Bus bus(url);
+  std::map<int64_t, std::array<cv::Rect, 2>> windows;
+  bus.subscribe<stereograsp::blob_t>("BLOB_.*", [&](const stereograsp::blob_t& b, const auto&) {
+    windows[b.utime][static_cast<size_t>(b.camera)] =
+        cv::Rect(b.search_window[0], b.search_window[1], b.search_window[2], b.search_window[3]);
+  });
+  Child viewer({program("sg-viewer"), "--record", dir + "/view.avi", "--frames", "15",
+                "--no-window", "--lcm-url", url});
+  Child vision({program("sg-vision"), "--frames", "20", "--lcm-url", url});
+  std::this_thread::sleep_for(1s);
+  Child sim({program("sg-camera-sim"), "--rate", "10", "--frames", "20", "--lcm-url", url});
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
+  while (windows.size() < 20 && std::chrono::steady_clock::now() < deadline) bus.handle(100ms);
+  const ProcessResult drawn = viewer.wait(30s);
+  ASSERT_EQ(drawn.exit_code, 0) << drawn.err;
+  EXPECT_NE(drawn.out.find("drew 15 frames"), std::string::npos) << drawn.out;
+
+  std::ifstream csv(dir + "/view.avi.csv");
+  std::string line;
+  std::getline(csv, line);
+  cv::VideoCapture video(dir + "/view.avi");
+  ASSERT_TRUE(video.isOpened());
+  cv::Mat frame;
+  int checked = 0;
+  while (video.read(frame) && std::getline(csv, line)) {
+    const int64_t utime = std::stoll(line.substr(line.find(',') + 1));
+    ASSERT_TRUE(windows.count(utime)) << "a recorded frame's utime is a published frame's";
+    ASSERT_EQ(frame.cols, 1280);
+    for (int cam = 0; cam < 2; ++cam) {
+      const cv::Rect w = windows[utime][static_cast<size_t>(cam)] + cv::Point(cam * 640, 0);
+      EXPECT_GT(yellow_on_edges(frame, w), 0.8) << "frame " << checked << " camera " << cam;
+      EXPECT_LT(yellow_on_edges(frame, w + cv::Point(0, 25)), 0.2) << "and not elsewhere";
+    }
+    ++checked;
+  }
+  EXPECT_EQ(checked, 15);
 }
 
 // learn-color prints config lines; bad input is one line and a non-zero exit.

@@ -195,7 +195,7 @@ TEST(Tracking, Robustness) {
 }
 
 // On the simulator's frames (lighting changes, noise, distractors, the wooden table) the blob's
-// centroid is the true ball image's centre within 0.5 px in both cameras.
+// centroid is the true ball image's centre within 0.3 px in both cameras.
 TEST(Tracking, SimulatedFramesAgainstTruth) {
   sim::SimParams p;
   p.lighting.gain_amplitude = 0.3;  // harsher than the default
@@ -222,7 +222,7 @@ TEST(Tracking, SimulatedFramesAgainstTruth) {
       worst = std::max(worst, cv::norm(o.blob.centroid - truth));
     }
   }
-  EXPECT_LT(worst, 0.5);
+  EXPECT_LT(worst, 0.3);
   std::printf("worst centroid error on simulated frames: %.3f px\n", worst);
 }
 
