@@ -52,6 +52,8 @@ TEST(Vision, PositionsFromSimulatedCamerasMatchTheTruth) {
   Child sim({program("sg-camera-sim"), "--rate", "10", "--frames", "30", "--lcm-url", url});
   const auto deadline = std::chrono::steady_clock::now() + 60s;
   while (measured.size() < 30 && std::chrono::steady_clock::now() < deadline) bus.handle(100ms);
+  while (bus.handle(300ms)) {  // the last frame's blobs follow its position
+  }
   EXPECT_EQ(sim.wait(30s).exit_code, 0);
   const ProcessResult v = vision.wait(30s);
   EXPECT_EQ(v.exit_code, 0) << v.err;
