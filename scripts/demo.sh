@@ -4,11 +4,12 @@
 #   scripts/demo.sh [--seconds N] [--tag NAME] [--with-images]
 #
 # Today: a one-second check that every stereograsp message type crosses the LCM bus intact
-# (sg-bus-check), then the simulated stereo cameras (sg-camera-sim) film the red ball on the
+# (sg-bus-check); then the simulated stereo cameras (sg-camera-sim) film the red ball on the
 # paper's path -- a 0.15 m circle at 1 rpm plus a drift along Y, hidden by a passing panel for two
-# seconds -- publishing CAMERA_LEFT, CAMERA_RIGHT and GROUND_TRUTH at 30 Hz, while the stock
-# lcm-logger records the session into logs/ (camera images only with --with-images: they are
-# large). Vision, prediction, the arm and grasping join this loop as they land.
+# seconds -- at 30 Hz; sg-vision finds the ball in both images and triangulates it with the
+# cameras' calibration (BLOB_LEFT, BLOB_RIGHT, OBJECT_POSITION); sg-viewer records the paper's
+# user interface to a video. The stock lcm-logger records the session into logs/ (camera images
+# only with --with-images: they are large). Prediction, the arm and grasping join as they land.
 #
 # The bus is LCM's default (or $LCM_DEFAULT_URL), so `scripts/spy.sh` in another terminal shows
 # the channels while the demo runs.
@@ -69,17 +70,36 @@ echo "   $(cat "$session.bus.txt")"
 rm -f "$session.bus.txt"
 
 frames=$(( seconds * 30 ))
-echo "demo: 2. the simulated cameras: the paper's motion at 30 Hz for $seconds s, occluded from 4 to 6 s"
-"$bin/sg-camera-sim" --frames "$frames" --occlusion 4:2 --calibration-out "$session.calibration.yaml" \
-  --log-level warn "${url_args[@]}" | sed 's/^/   /' || status=1
-"$bin/sg-camera-sim" --snapshot "$session.pair.png" --snapshot-frame 60 --log-level warn | sed 's/^/   /'
+echo "demo: 2. the cameras' calibration (the simulator's own: robot-guided calibration comes later)"
+"$bin/sg-camera-sim" --snapshot "$session.pair.png" --snapshot-frame 60 \
+  --calibration-out "$session.calibration.yaml" --log-level warn | sed 's/^/   /'
+
+echo "demo: 3. cameras -> vision -> viewer: the paper's motion at 30 Hz for $seconds s, occluded from 4 to 6 s"
+"$bin/sg-vision" --calibration "$session.calibration.yaml" --log-level warn "${url_args[@]}" \
+  > "$session.vision.txt" &
+vision_pid=$!
+"$bin/sg-viewer" --record "$session.view.avi" --no-window --calibration "$session.calibration.yaml" \
+  --log-level warn "${url_args[@]}" > "$session.viewer.txt" &
+viewer_pid=$!
+pids+=("$vision_pid" "$viewer_pid")
+sleep 1
+"$bin/sg-camera-sim" --frames "$frames" --occlusion 4:2 --log-level warn "${url_args[@]}" \
+  | sed 's/^/   sg-camera-sim: /' || status=1
+sleep 1
+kill -INT "$vision_pid" "$viewer_pid"
+wait "$vision_pid" || status=1
+wait "$viewer_pid" || status=1
+pids=("$logger_pid")
+echo "   sg-vision: $(cat "$session.vision.txt")"
+echo "   sg-viewer: $(cat "$session.viewer.txt")"
+rm -f "$session.vision.txt" "$session.viewer.txt"
 
 sleep 0.5
 kill -INT "$logger_pid"
 wait "$logger_pid" || true
 pids=()
 
-echo "demo: 3. what the log holds:"
+echo "demo: 4. what the log holds:"
 "$bin/sg-bus-check" verify-log "$log" --count 100 | sed 's/^/   /' || status=1
 if [ "$status" -ne 0 ]; then
   echo "demo: FAILED (log kept: $log)" >&2
@@ -89,6 +109,7 @@ cat <<MSG
 demo: done. The session log is $log
   the cameras' true calibration: $session.calibration.yaml
   a stereo pair as the cameras saw it: $session.pair.png
+  the user interface, recorded: $session.view.avi (frame-to-utime: $session.view.avi.csv)
   replay it:   lcm-logplayer $log
   inspect it:  scripts/spy.sh (while replaying or during a demo)
 MSG

@@ -48,7 +48,11 @@ Observation BlobTracker::track(const cv::Mat& bgr, const std::optional<cv::Point
     o.tracking = false;
     o.window = cv::Rect(0, 0, size_.width, size_.height);
   }
-  const Segmentation s = segmenter_.run(bgr, o.window, detector_, params_.min_area);
+  int min_area = params_.min_area;
+  if (has_track_ && misses_ < params_.forget_size_after_misses) {
+    min_area = std::max(min_area, static_cast<int>(params_.min_area_fraction_of_last * last_area_));
+  }
+  const Segmentation s = segmenter_.run(bgr, o.window, detector_, min_area);
   o.num_regions = s.num_regions;
   o.found = s.found;
   if (s.found) {
@@ -56,6 +60,7 @@ Observation BlobTracker::track(const cv::Mat& bgr, const std::optional<cv::Point
     has_track_ = true;
     last_centre_ = o.blob.centroid;
     last_diameter_ = o.blob.major_axis;
+    last_area_ = o.blob.area;
     misses_ = 0;
   } else if (has_track_) {
     ++misses_;

@@ -48,6 +48,11 @@ class BlobTracker {
     ColorThresholds color;
     SearchWindowParams window;
     int min_area = 30;  ///< px; smaller regions of the colour are ignored (section 5.2)
+    /// While a track is recent, a region must also be at least this fraction of the ball's last
+    /// area: a red sticker a few percent of the ball's size is not taken for it when it hides.
+    double min_area_fraction_of_last = 0.2;
+    /// Misses after which the ball's last size is forgotten (it may come back at any size).
+    int forget_size_after_misses = 150;
   };
 
   BlobTracker(const Params& params, cv::Size image_size);
@@ -68,6 +73,7 @@ class BlobTracker {
   bool has_track_ = false;
   cv::Point2d last_centre_;
   double last_diameter_ = 0;
+  double last_area_ = 0;
   int misses_ = 0;
 };
 

@@ -34,8 +34,10 @@ class ColorDetector {
     const int64_t b = bgr[0], g = bgr[1], r = bgr[2];
     const int64_t sum = b + g + r;
     if (sum < min_sum_) return false;
-    return r * kOne >= r_lo_ * sum && r * kOne <= r_hi_ * sum && g * kOne >= g_lo_ * sum &&
-           g * kOne <= g_hi_ * sum && b * kOne >= b_lo_ * sum && b * kOne <= b_hi_ * sum;
+    // The bounds that reject most of a lab's pixels first: grey and wooden surfaces fail r >= r_min
+    // or g <= g_max.
+    return r * kOne >= r_lo_ * sum && g * kOne <= g_hi_ * sum && b * kOne <= b_hi_ * sum &&
+           r * kOne <= r_hi_ * sum && g * kOne >= g_lo_ * sum && b * kOne >= b_lo_ * sum;
   }
 
   /// A binary image (CV_8U, 255 for object) of the pixels of `bgr` inside `roi`.

@@ -23,6 +23,12 @@ BlobTracker::Params load_tracker_params(const Config& c) {
     throw c.error_at("vision.min_intensity", "must be between 0 and 765");
   p.min_area = c.get<int>("vision.min_area", p.min_area);
   if (p.min_area < 1) throw c.error_at("vision.min_area", "must be at least 1");
+  p.min_area_fraction_of_last =
+      c.get<double>("vision.min_area_fraction_of_last", p.min_area_fraction_of_last);
+  if (!(p.min_area_fraction_of_last >= 0 && p.min_area_fraction_of_last <= 1))
+    throw c.error_at("vision.min_area_fraction_of_last", "must be in [0, 1]");
+  p.forget_size_after_misses =
+      c.get<int>("vision.forget_size_after_misses", p.forget_size_after_misses);
   SearchWindowParams& w = p.window;
   w.diameter_factor = c.get<double>("vision.window_diameter_factor", w.diameter_factor);
   w.max_width_fraction = c.get<double>("vision.window_max_width", w.max_width_fraction);

@@ -123,6 +123,24 @@ TEST(Tracking, LeavesAndComesBack) {
   EXPECT_TRUE(tracker.track(elsewhere).tracking);
 }
 
+// When the ball hides, a small red distractor is not taken for it, even in full-frame search; the
+// ball is found again when it returns, and after a long absence any size is accepted again.
+TEST(Tracking, DistractorIsNotTakenForTheHiddenBall) {
+  BlobTracker::Params p = params();
+  p.forget_size_after_misses = 20;
+  BlobTracker tracker(p, {640, 480});
+  cv::Mat with_ball = grey_image(), sticker_only = grey_image();
+  cv::circle(with_ball, {300, 200}, 25, kRed, cv::FILLED);
+  for (cv::Mat* m : {&with_ball, &sticker_only}) cv::circle(*m, {550, 400}, 6, kRed, cv::FILLED);
+  ASSERT_TRUE(tracker.track(with_ball).found);
+  for (int k = 0; k < 10; ++k) EXPECT_FALSE(tracker.track(sticker_only).found) << k;
+  EXPECT_TRUE(tracker.track(with_ball).found);
+  for (int k = 0; k < 20; ++k) tracker.track(sticker_only);
+  const Observation o = tracker.track(sticker_only);
+  EXPECT_TRUE(o.found) << "the size was forgotten";
+  EXPECT_NEAR(o.blob.centroid.x, 550, 0.5);
+}
+
 // A prediction moves the window: a ball far from its last position is found where predicted.
 TEST(Tracking, PredictedPositionCentresTheWindow) {
   BlobTracker tracker(params(), {640, 480});
