@@ -3,8 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <map>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 #include <thread>
 
@@ -152,6 +154,42 @@ TEST(Viewer, RecordedViewShowsTheSearchWindowWhereTheBlobWas) {
     ++checked;
   }
   EXPECT_EQ(checked, 15);
+}
+
+// Two folders of images, paired by name; --publish-images republishes them as JPEG image_t.
+TEST(Vision, ImageFoldersSourceRepublishesFrames) {
+  constexpr int kPort = 7912;
+  ASSERT_TRUE(multicast_available(kPort));
+  const std::string dir = make_temp_dir();
+  ASSERT_EQ(run({program("sg-camera-sim"), "--write", dir, "--frames", "6"}, 120s).exit_code, 0);
+  for (const char* side : {"left", "right"}) {
+    std::filesystem::create_directory(dir + "/" + side);
+    cv::VideoCapture video(dir + "/" + side + ".avi");
+    cv::Mat frame;
+    for (int k = 0; video.read(frame); ++k) {
+      cv::imwrite(dir + "/" + side + "/frame" + std::to_string(100 + k) + ".png", frame);
+    }
+  }
+  Bus bus(test_url(kPort));
+  int images = 0, blobs = 0;
+  bus.subscribe<stereograsp::image_t>("CAMERA_.*", [&](const auto& m, const auto&) {
+    std::string error;
+    images += sg::vision::decode_image(m, &error).has_value();
+  });
+  bus.subscribe<stereograsp::blob_t>("BLOB_.*",
+                                     [&](const auto& b, const auto&) { blobs += b.found; });
+  const ProcessResult v =
+      run({program("sg-vision"), "--source", "images", "--left", dir + "/left", "--right",
+           dir + "/right", "--publish-images", "--rate", "10", "--lcm-url", test_url(kPort)},
+          60s);
+  EXPECT_EQ(v.exit_code, 0) << v.err;
+  while (bus.handle(300ms)) {
+  }
+  EXPECT_NE(v.out.find("processed 6 stereo frames: ball found left 100.0%, right 100.0%"),
+            std::string::npos)
+      << v.out;
+  EXPECT_EQ(images, 12);
+  EXPECT_EQ(blobs, 12);
 }
 
 // learn-color prints config lines; bad input is one line and a non-zero exit.
