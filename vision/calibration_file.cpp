@@ -73,7 +73,7 @@ CameraModel read_camera(const cv::FileNode& node, const std::string& path, const
   }
   *rms = node["rms"].empty() ? 0.0 : static_cast<double>(node["rms"]);
   const Intrinsics in{K.at<double>(0, 0), K.at<double>(1, 1), K.at<double>(0, 2),
-                      K.at<double>(1, 2)};
+                      K.at<double>(1, 2), K.at<double>(0, 1)};
   const Distortion dist{D.at<double>(0), D.at<double>(1), D.at<double>(2), D.at<double>(3),
                         D.at<double>(4)};
   try {

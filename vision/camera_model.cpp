@@ -36,6 +36,7 @@ Eigen::Matrix3d CameraModel::K() const {
   Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
   K(0, 0) = intrinsics_.fx;
   K(1, 1) = intrinsics_.fy;
+  K(0, 1) = intrinsics_.skew;
   K(0, 2) = intrinsics_.cx;
   K(1, 2) = intrinsics_.cy;
   return K;
@@ -55,7 +56,8 @@ std::optional<Eigen::Vector2d> CameraModel::project(const Eigen::Vector3d& world
 
 Eigen::Vector2d CameraModel::project_camera(const Eigen::Vector3d& c) const {
   const Eigen::Vector2d d = distort({c.x() / c.z(), c.y() / c.z()});
-  return {intrinsics_.fx * d.x() + intrinsics_.cx, intrinsics_.fy * d.y() + intrinsics_.cy};
+  return {intrinsics_.fx * d.x() + intrinsics_.skew * d.y() + intrinsics_.cx,
+          intrinsics_.fy * d.y() + intrinsics_.cy};
 }
 
 Eigen::Vector2d CameraModel::distort(const Eigen::Vector2d& n) const {
@@ -75,8 +77,8 @@ Eigen::Vector2d CameraModel::undistort(const Eigen::Vector2d& d) const {
 }
 
 Eigen::Vector3d CameraModel::ray_camera(const Eigen::Vector2d& pixel) const {
-  const Eigen::Vector2d d{(pixel.x() - intrinsics_.cx) / intrinsics_.fx,
-                          (pixel.y() - intrinsics_.cy) / intrinsics_.fy};
+  const double y = (pixel.y() - intrinsics_.cy) / intrinsics_.fy;
+  const Eigen::Vector2d d{(pixel.x() - intrinsics_.cx - intrinsics_.skew * y) / intrinsics_.fx, y};
   const Eigen::Vector2d n = undistort(d);
   return Eigen::Vector3d(n.x(), n.y(), 1.0).normalized();
 }

@@ -6,12 +6,14 @@
 
 namespace sg::vision {
 
-/// Focal lengths and principal point, pixels.
+/// Focal lengths, principal point and skew, pixels: K = [fx skew cx; 0 fy cy; 0 0 1]. Skew is 0
+/// for real cameras and in OpenCV's model; a DLT estimate keeps its own so that K [R|t] is its P.
 struct Intrinsics {
   double fx = 560.0;
   double fy = 560.0;
   double cx = 319.5;
   double cy = 239.5;
+  double skew = 0.0;
 };
 
 /// OpenCV's lens distortion model (k1, k2, p1, p2, k3), on normalized coordinates:

@@ -147,7 +147,7 @@ CameraModel decompose_projection(const Matrix34& P_in, int width, int height) {
   if (R.determinant() < 0) throw CalibrationInputError("P does not decompose into a rotation");
   const Eigen::Vector3d t = K.inverse() * P.col(3);
   K /= K(2, 2);
-  return CameraModel(width, height, {K(0, 0), K(1, 1), K(0, 2), K(1, 2)}, {}, R, t);
+  return CameraModel(width, height, {K(0, 0), K(1, 1), K(0, 2), K(1, 2), K(0, 1)}, {}, R, t);
 }
 
 DltResult calibrate_dlt(const std::vector<Correspondence>& points, int width, int height,

@@ -1,0 +1,167 @@
+// sg-calibrate as a process: DLT from CSV files, the real checkerboard set, registration to the
+// robot frame, and bad input that leaves a good file as it was.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <random>
+#include <sstream>
+
+#include "sim/stereo_rig.hpp"
+#include "tests/support/subprocess.hpp"
+#include "vision/calibration_file.hpp"
+#include "vision/registration.hpp"
+#include "vision/triangulation.hpp"
+
+namespace sg::test {
+namespace {
+
+using namespace std::chrono_literals;
+namespace fs = std::filesystem;
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+std::vector<Eigen::Vector3d> workspace(int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> x(0.2, 0.7), y(-0.3, 0.3), z(0.0, 0.3);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < n; ++i) points.emplace_back(x(rng), y(rng), z(rng));
+  return points;
+}
+
+// DLT from two CSV files of the simulated rig's points (0.3 px noise): a calibration file whose
+// cameras triangulate new points across the workspace within 2 mm RMS.
+TEST(Calibrate, DltFromCsv) {
+  const std::string dir = make_temp_dir();
+  const auto rig = sim::make_rig({});
+  std::mt19937 rng(4);
+  std::normal_distribution<double> noise(0, 0.3);
+  for (int c = 0; c < 2; ++c) {
+    std::ofstream csv(dir + (c == 0 ? "/left.csv" : "/right.csv"));
+    csv << "X,Y,Z,u,v\n# points carried by the arm\n" << std::setprecision(17);
+    for (const auto& p : workspace(30, 8)) {
+      const Eigen::Vector2d px = *rig[static_cast<size_t>(c)].project(p);
+      csv << p.x() << "," << p.y() << "," << p.z() << "," << px.x() + noise(rng) << ","
+          << px.y() + noise(rng) << "\n";
+    }
+  }
+  const ProcessResult r = run({program("sg-calibrate"), "dlt", "--left", dir + "/left.csv",
+                               "--right", dir + "/right.csv", "--out", dir + "/cams.yaml"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("left camera: 30 points, RMS reprojection error 0."), std::string::npos)
+      << r.out;
+  const auto c = vision::read_calibration(dir + "/cams.yaml");
+  double sum = 0;
+  const auto test_points = workspace(50, 77);
+  for (const auto& p : test_points) {
+    const auto t =
+        vision::triangulate({&c.left, &c.right}, {*rig[0].project(p), *rig[1].project(p)});
+    sum += (t.position - p).squaredNorm();
+  }
+  EXPECT_LT(std::sqrt(sum / test_points.size()), 0.002);
+}
+
+// The real stereo set: 13 views used, the baseline OpenCV's sample found, a readable file.
+TEST(Calibrate, CheckerboardOnRealImages) {
+  const std::string dir = make_temp_dir();
+  for (const char* side : {"left", "right"}) {
+    fs::create_directory(dir + "/" + side);
+    for (const auto& e : fs::directory_iterator(std::string(SG_SOURCE_DIR) +
+                                                "/tests/fixtures/stereo_checkerboard")) {
+      if (e.path().filename().string().rfind(side, 0) == 0)
+        fs::copy(e.path(), dir + "/" + side + "/" + e.path().filename().string());
+    }
+  }
+  const ProcessResult r =
+      run({program("sg-calibrate"), "checkerboard", "--left", dir + "/left", "--right",
+           dir + "/right", "--pattern", "9x6", "--square", "0.025", "--out", dir + "/cams.yaml"},
+          120s);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  int used = 0;
+  for (size_t at = r.out.find(" yes "); at != std::string::npos; at = r.out.find(" yes ", at + 1))
+    ++used;
+  EXPECT_EQ(used, 13) << r.out;
+  EXPECT_NE(r.err.find("finding the board in left01.jpg (1 of 26)"), std::string::npos)
+      << "progress";
+  const auto c = vision::read_calibration(dir + "/cams.yaml");
+  EXPECT_NEAR((c.right.centre() - c.left.centre()).norm(), 0.08358, 0.0008);
+}
+
+// Registration: a calibration in another frame, plus points known in the robot frame, gives the
+// robot-frame calibration back.
+TEST(Calibrate, RegisterMovesTheCalibrationIntoTheRobotFrame) {
+  const std::string dir = make_temp_dir();
+  const auto rig = sim::make_rig({});
+  vision::StereoCalibration robot_frame;
+  robot_frame.left = rig[0];
+  robot_frame.right = rig[1];
+  Eigen::Isometry3d robot_from_camera = Eigen::Isometry3d::Identity();  // any frame will do
+  robot_from_camera.linear() =
+      Eigen::AngleAxisd(1.1, Eigen::Vector3d(0.2, -1, 0.4).normalized()).toRotationMatrix();
+  robot_from_camera.translation() = Eigen::Vector3d(0.5, 0.1, -0.3);
+  vision::write_calibration(dir + "/camera_frame.yaml",
+                            vision::change_world_frame(robot_frame, robot_from_camera));
+  std::ofstream csv(dir + "/marks.csv");
+  csv << std::setprecision(17);
+  for (const auto& p : workspace(8, 3)) {
+    const Eigen::Vector2d l = *rig[0].project(p), r = *rig[1].project(p);
+    csv << p.x() << "," << p.y() << "," << p.z() << "," << l.x() << "," << l.y() << "," << r.x()
+        << "," << r.y() << "\n";
+  }
+  csv.close();
+  const ProcessResult r =
+      run({program("sg-calibrate"), "register", "--calibration", dir + "/camera_frame.yaml",
+           "--points", dir + "/marks.csv", "--out", dir + "/robot.yaml"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto back = vision::read_calibration(dir + "/robot.yaml");
+  for (const auto& p : workspace(20, 90)) {
+    EXPECT_LT((*back.left.project(p) - *rig[0].project(p)).norm(), 1e-6);
+    EXPECT_LT((*back.right.project(p) - *rig[1].project(p)).norm(), 1e-6);
+  }
+}
+
+// Bad input: one line naming the file and line or the problem; an existing file stays as it was.
+TEST(Calibrate, BadInputLeavesTheGoodFile) {
+  const std::string dir = make_temp_dir();
+  const std::string good = dir + "/cams.yaml";
+  const auto rig = sim::make_rig({});
+  vision::StereoCalibration c;
+  c.left = rig[0];
+  c.right = rig[1];
+  vision::write_calibration(good, c);
+  const std::string before = slurp(good);
+  std::ofstream(dir + "/bad.csv") << "X,Y,Z,u,v\n0.1,0.2,0.3,10,20\n0.1,abc,0.3,10,20\n";
+  std::ofstream flat(dir + "/flat.csv");
+  for (int i = 0; i < 10; ++i)
+    flat << 0.1 * i << "," << 0.05 * (i % 3) << ",0.1," << 10 * i << "," << 7 * i << "\n";
+  flat.close();
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"dlt", "--left", dir + "/bad.csv", "--right", dir + "/bad.csv"},
+       "bad.csv:3: 'abc' is not a number"},
+      {{"dlt", "--left", dir + "/flat.csv", "--right", dir + "/flat.csv"}, "one plane"},
+      {{"dlt", "--left", dir + "/none.csv", "--right", dir + "/none.csv"}, "none.csv: cannot open"},
+      {{"checkerboard", "--left", dir, "--right", dir, "--pattern", "nine"},
+       "expected inner corners"},
+      {{"checkerboard", "--left", "/nonexistent", "--right", dir}, "not a folder"},
+  };
+  for (const auto& [args, needle] : cases) {
+    std::vector<std::string> argv = {program("sg-calibrate")};
+    argv.insert(argv.end(), args.begin(), args.end());
+    argv.insert(argv.end(), {"--out", good});
+    const ProcessResult r = run(argv, 60s);
+    EXPECT_EQ(r.exit_code, 1) << needle;
+    EXPECT_EQ(count_lines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(needle), std::string::npos) << r.err;
+    EXPECT_EQ(slurp(good), before) << "the good file is untouched";
+  }
+}
+
+}  // namespace
+}  // namespace sg::test

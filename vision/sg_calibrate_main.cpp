@@ -1,0 +1,211 @@
+// sg-calibrate: the cameras' calibration (section 4) and its registration to the robot's frame.
+//
+//   sg-calibrate dlt --left left.csv --right right.csv --out cams.yaml
+//        each CSV line X,Y,Z,u,v: a point in the robot frame (m) and its pixel in that camera
+//   sg-calibrate checkerboard --left dirL --right dirR --pattern 9x6 --square 0.025 --out cams.yaml
+//   sg-calibrate register --calibration cams.yaml --points marks.csv --out robot.yaml
+//        each CSV line X,Y,Z,u_left,v_left,u_right,v_right: a point known in the robot frame and
+//        where both cameras see it; the calibration is moved into the robot's frame
+// A file is written only when the whole calibration succeeded (never a partial one over a good
+// one).
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "common/program.hpp"
+#include "vision/checkerboard.hpp"
+#include "vision/dlt.hpp"
+#include "vision/registration.hpp"
+#include "vision/triangulation.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using sg::vision::CalibrationInputError;
+
+/// Rows of `columns` numbers from a CSV file; a header line and '#' comments are skipped; errors
+/// name the file and the line.
+std::vector<std::vector<double>> read_rows(const std::string& path, size_t columns) {
+  std::ifstream file(path);
+  if (!file) throw std::runtime_error(path + ": cannot open");
+  std::vector<std::vector<double>> rows;
+  std::string line;
+  for (int number = 1; std::getline(file, line); ++number) {
+    if (line.empty() || line[0] == '#') continue;
+    std::vector<double> row;
+    std::stringstream cells(line);
+    std::string cell;
+    bool header = false;
+    while (std::getline(cells, cell, ',')) {
+      try {
+        size_t used = 0;
+        row.push_back(std::stod(cell, &used));
+        if (cell.find_first_not_of(" \t\r", used) != std::string::npos)
+          throw std::invalid_argument(cell);
+      } catch (const std::exception&) {
+        if (rows.empty() && number == 1) {
+          header = true;
+          break;
+        }
+        throw std::runtime_error(path + ":" + std::to_string(number) + ": '" + cell +
+                                 "' is not a number");
+      }
+    }
+    if (header) continue;
+    if (row.size() != columns) {
+      throw std::runtime_error(path + ":" + std::to_string(number) + ": expected " +
+                               std::to_string(columns) + " numbers, found " +
+                               std::to_string(row.size()));
+    }
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+std::vector<std::string> images_in(const std::string& dir) {
+  if (!fs::is_directory(dir)) throw std::runtime_error(dir + ": not a folder");
+  std::vector<std::string> files;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    std::string ext = e.path().extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+    if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp")
+      files.push_back(e.path());
+  }
+  std::sort(files.begin(), files.end());
+  if (files.empty()) throw std::runtime_error(dir + ": holds no images");
+  return files;
+}
+
+int run_dlt(const std::string& left_csv, const std::string& right_csv, int width, int height,
+            const std::string& out) {
+  sg::vision::StereoCalibration c;
+  double rms[2];
+  for (int i = 0; i < 2; ++i) {
+    const std::string& path = i == 0 ? left_csv : right_csv;
+    std::vector<sg::vision::Correspondence> points;
+    for (const auto& r : read_rows(path, 5)) points.push_back({{r[0], r[1], r[2]}, {r[3], r[4]}});
+    sg::vision::DltResult result;
+    try {
+      result = sg::vision::calibrate_dlt(points, width, height);
+    } catch (const CalibrationInputError& e) {
+      throw std::runtime_error(path + ": " + e.what());
+    }
+    std::printf("%s camera: %zu points, RMS reprojection error %.3f px (linear %.3f px)\n",
+                i == 0 ? "left" : "right", points.size(), result.rms, result.rms_linear);
+    (i == 0 ? c.left : c.right) = result.camera;
+    rms[i] = result.rms;
+  }
+  c.rms_left = rms[0];
+  c.rms_right = rms[1];
+  c.source = "sg-calibrate dlt";
+  sg::vision::write_calibration(out, c);
+  std::printf("wrote %s\n", out.c_str());
+  return 0;
+}
+
+int run_checkerboard(const std::string& left_dir, const std::string& right_dir,
+                     const std::string& pattern, double square, const std::string& out) {
+  int w = 0, h = 0;
+  char x = 0;
+  std::istringstream in(pattern);
+  if (!(in >> w >> x >> h) || x != 'x' || w < 2 || h < 2)
+    throw std::runtime_error("--pattern '" + pattern +
+                             "': expected inner corners as COLSxROWS, e.g. 9x6");
+  const auto left = images_in(left_dir), right = images_in(right_dir);
+  size_t done = 0;
+  const auto result = sg::vision::calibrate_checkerboard(
+      left, right, {{w, h}, square}, [&](const std::string& file) {
+        spdlog::info("finding the board in {} ({} of {})", fs::path(file).filename().string(),
+                     ++done, left.size() + right.size());
+      });
+  std::printf("%-20s %-20s %-8s %10s %10s\n", "left", "right", "used", "rms left", "rms right");
+  for (const auto& v : result.views) {
+    if (v.used) {
+      std::printf("%-20s %-20s %-8s %10.3f %10.3f\n", fs::path(v.left).filename().c_str(),
+                  fs::path(v.right).filename().c_str(), "yes", v.rms_left, v.rms_right);
+    } else {
+      std::printf("%-20s %-20s dropped: %s\n", fs::path(v.left).filename().c_str(),
+                  fs::path(v.right).filename().c_str(), v.dropped_because.c_str());
+    }
+  }
+  const auto& c = result.calibration;
+  std::printf(
+      "RMS reprojection error: left %.3f px, right %.3f px, stereo %.3f px; baseline %.1f mm\n",
+      c.rms_left, c.rms_right, result.rms_stereo,
+      (c.right.centre() - c.left.centre()).norm() * 1e3);
+  sg::vision::write_calibration(out, c);
+  std::printf(
+      "wrote %s (frame: the left camera's; move it to the robot's with `sg-calibrate register`)\n",
+      out.c_str());
+  return 0;
+}
+
+int run_register(const std::string& calibration_path, const std::string& points_csv,
+                 const std::string& out) {
+  const auto c = sg::vision::read_calibration(calibration_path);
+  std::vector<Eigen::Vector3d> robot, seen;
+  for (const auto& r : read_rows(points_csv, 7)) {
+    const auto t = sg::vision::triangulate({&c.left, &c.right}, {{r[3], r[4]}, {r[5], r[6]}});
+    robot.emplace_back(r[0], r[1], r[2]);
+    seen.push_back(t.position);
+  }
+  sg::vision::RigidFit fit;
+  try {
+    fit = sg::vision::fit_rigid(robot, seen);
+  } catch (const CalibrationInputError& e) {
+    throw std::runtime_error(points_csv + ": " + e.what());
+  }
+  auto moved = sg::vision::change_world_frame(c, fit.transform);
+  moved.source =
+      c.source + ", registered to the robot frame with " + std::to_string(robot.size()) + " points";
+  moved.date.clear();
+  std::printf("registration: %zu points, RMS %.2f mm\n", robot.size(), fit.rms * 1e3);
+  sg::vision::write_calibration(out, moved);
+  std::printf("wrote %s\n", out.c_str());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Calibrates the stereo cameras and registers them to the robot's frame.",
+               "sg-calibrate"};
+  app.require_subcommand(1);
+  sg::CommonOptions common;
+  sg::add_common_options(app, common);
+  std::string left, right, out, pattern = "9x6", calibration, points;
+  int width = 640, height = 480;
+  double square = 0.025;
+
+  CLI::App* dlt = app.add_subcommand("dlt", "DLT from points known in the robot frame (eq. 1-6)");
+  dlt->add_option("--left", left, "left camera's CSV: X,Y,Z,u,v per line")->required();
+  dlt->add_option("--right", right, "right camera's CSV: X,Y,Z,u,v per line")->required();
+  dlt->add_option("--width", width, "image width (px)");
+  dlt->add_option("--height", height, "image height (px)");
+  dlt->add_option("--out", out, "calibration file to write")->required();
+
+  CLI::App* board = app.add_subcommand(
+      "checkerboard", "Intrinsics, distortion and stereo extrinsics from board images");
+  board->add_option("--left", left, "folder of left images")->required();
+  board->add_option("--right", right, "folder of right images (paired by sorted name)")->required();
+  board->add_option("--pattern", pattern, "inner corners COLSxROWS (default 9x6)");
+  board->add_option("--square", square, "side of a square (m)")->check(CLI::PositiveNumber);
+  board->add_option("--out", out, "calibration file to write")->required();
+
+  CLI::App* reg = app.add_subcommand("register", "Move a calibration into the robot's frame");
+  reg->add_option("--calibration", calibration, "calibration in the cameras' frame")->required();
+  reg->add_option("--points", points, "CSV: X,Y,Z (robot frame), u_left,v_left,u_right,v_right")
+      ->required();
+  reg->add_option("--out", out, "calibration file to write")->required();
+
+  return sg::run_program(app, argc, argv, [&] {
+    sg::load_common(common);
+    if (*dlt) return run_dlt(left, right, width, height, out);
+    if (*board) return run_checkerboard(left, right, pattern, square, out);
+    return run_register(calibration, points, out);
+  });
+}
