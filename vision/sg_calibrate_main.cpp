@@ -3,6 +3,10 @@
 //   sg-calibrate dlt --left left.csv --right right.csv --out cams.yaml
 //        each CSV line X,Y,Z,u,v: a point in the robot frame (m) and its pixel in that camera
 //   sg-calibrate checkerboard --left dirL --right dirR --pattern 9x6 --square 0.025 --out cams.yaml
+//   sg-calibrate robot --out cams.yaml
+//        the arm holds the ball; sg-calibrate moves it (ARM_COMMAND) through a grid of 18
+//        positions, waits for ARM_STATUS to report each arrival, averages BLOB_LEFT/RIGHT there,
+//        and solves the DLT of both cameras in the robot frame
 //   sg-calibrate register --calibration cams.yaml --points marks.csv --out robot.yaml
 //        each CSV line X,Y,Z,u_left,v_left,u_right,v_right: a point known in the robot frame and
 //        where both cameras see it; the calibration is moved into the robot's frame
@@ -16,10 +20,15 @@
 #include <fstream>
 #include <sstream>
 
+#include "common/bus.hpp"
+#include "common/clock.hpp"
+#include "common/message_types.hpp"
 #include "common/program.hpp"
+#include "common/shutdown.hpp"
 #include "vision/checkerboard.hpp"
 #include "vision/dlt.hpp"
 #include "vision/registration.hpp"
+#include "vision/robot_calibration.hpp"
 #include "vision/triangulation.hpp"
 
 namespace {
@@ -169,6 +178,70 @@ int run_register(const std::string& calibration_path, const std::string& points_
   return 0;
 }
 
+int run_robot(const std::string& url, const sg::vision::RobotCalibrationParams& params,
+              double timeout_s, const std::string& out) {
+  sg::install_shutdown_handlers();
+  sg::Bus bus(url);
+  // Sequence numbers from the clock, so they are newer than any the driver has seen.
+  sg::vision::RobotCalibration cal(params, sg::now_utime());
+  std::string arm_error;  // handlers run inside LCM's C code: they record, the loop throws
+  bus.subscribe<stereograsp::arm_status_t>("ARM_STATUS", [&](const auto& s, const auto&) {
+    if (s.state == stereograsp::arm_status_t::STATE_ERROR ||
+        s.state == stereograsp::arm_status_t::STATE_DISCONNECTED)
+      arm_error = "the arm reports " + std::string(s.error.empty() ? "an error" : s.error);
+    cal.on_arm_status(s.utime, s.last_executed_sequence,
+                      s.state == stereograsp::arm_status_t::STATE_IDLE);
+  });
+  bus.subscribe<stereograsp::blob_t>("BLOB_(LEFT|RIGHT)", [&](const auto& b, const auto&) {
+    cal.on_blob(b.camera, b.utime, b.found, {b.centroid[0], b.centroid[1]});
+  });
+  std::string last_progress;
+  auto last_change = std::chrono::steady_clock::now();
+  bus.spin([&] {
+    if (!arm_error.empty())
+      throw std::runtime_error(arm_error + " at " + cal.progress() + "; nothing written");
+    if (auto t = cal.next_target()) {
+      stereograsp::arm_cmd_t cmd{};
+      cmd.utime = sg::now_utime();
+      cmd.sequence = t->sequence;
+      cmd.mode = stereograsp::arm_cmd_t::MODE_CARTESIAN;
+      for (int i = 0; i < 3; ++i) cmd.position[i] = t->position[i], cmd.orientation[i] = t->rpy[i];
+      cmd.gripper = stereograsp::arm_cmd_t::GRIPPER_KEEP;
+      cmd.speed = t->speed;
+      cmd.sender = "sg-calibrate";
+      bus.publish("ARM_COMMAND", cmd);
+    }
+    const std::string progress = cal.progress();
+    if (progress != last_progress) {
+      spdlog::info("{}", progress);
+      last_progress = progress;
+      last_change = std::chrono::steady_clock::now();
+    }
+    if (std::chrono::steady_clock::now() - last_change > std::chrono::duration<double>(timeout_s)) {
+      throw std::runtime_error(
+          "no progress for " + std::to_string(static_cast<int>(timeout_s)) + " s at " + progress +
+          " (are sg-arm-driver and sg-vision running, and the ball in the gripper?)");
+    }
+    return !cal.done();
+  });
+  if (!cal.done())
+    throw std::runtime_error("interrupted at " + cal.progress() + "; nothing written");
+  int skipped = 0;
+  for (const auto& s : cal.stops()) skipped += s.skipped;
+  sg::vision::StereoCalibration c;
+  try {
+    c = cal.solve();
+  } catch (const CalibrationInputError& e) {
+    throw std::runtime_error(e.what());
+  }
+  std::printf(
+      "%zu stops (%d skipped: ball not seen); RMS reprojection error left %.3f px, right %.3f px\n",
+      cal.stops().size(), skipped, c.rms_left, c.rms_right);
+  sg::vision::write_calibration(out, c);
+  std::printf("wrote %s (robot frame)\n", out.c_str());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -196,6 +269,19 @@ int main(int argc, char** argv) {
   board->add_option("--square", square, "side of a square (m)")->check(CLI::PositiveNumber);
   board->add_option("--out", out, "calibration file to write")->required();
 
+  sg::vision::RobotCalibrationParams robot_params;
+  double timeout_s = 30;
+  CLI::App* robot = app.add_subcommand(
+      "robot", "Arm-guided: the arm carries the ball through a grid (section 4)");
+  robot->add_option("--out", out, "calibration file to write")->required();
+  robot->add_option("--frames-per-stop", robot_params.frames_per_stop,
+                    "blobs averaged per camera at each stop");
+  robot->add_option("--settle", robot_params.settle, "seconds after arrival before blobs count");
+  robot->add_option("--speed", robot_params.speed, "arm speed, fraction of maximum");
+  robot->add_option("--width", robot_params.image_width, "image width (px)");
+  robot->add_option("--height", robot_params.image_height, "image height (px)");
+  robot->add_option("--timeout", timeout_s, "give up after this many seconds without progress");
+
   CLI::App* reg = app.add_subcommand("register", "Move a calibration into the robot's frame");
   reg->add_option("--calibration", calibration, "calibration in the cameras' frame")->required();
   reg->add_option("--points", points, "CSV: X,Y,Z (robot frame), u_left,v_left,u_right,v_right")
@@ -206,6 +292,7 @@ int main(int argc, char** argv) {
     sg::load_common(common);
     if (*dlt) return run_dlt(left, right, width, height, out);
     if (*board) return run_checkerboard(left, right, pattern, square, out);
+    if (*robot) return run_robot(common.lcm_url, robot_params, timeout_s, out);
     return run_register(calibration, points, out);
   });
 }

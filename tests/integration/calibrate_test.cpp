@@ -165,3 +165,77 @@ TEST(Calibrate, BadInputLeavesTheGoodFile) {
 
 }  // namespace
 }  // namespace sg::test
+
+#include "common/bus.hpp"
+#include "common/clock.hpp"
+#include "common/message_types.hpp"
+#include "tests/integration/multicast_guard.hpp"
+#include "vision/triangulation.hpp"
+
+namespace sg::test {
+namespace {
+
+// sg-calibrate robot over LCM. The test plays the arm (ARM_STATUS after each ARM_COMMAND) and the
+// vision stage (BLOB_LEFT/RIGHT of the carried ball, projected by the true cameras): the written
+// calibration triangulates the workspace within 2 mm in the robot frame.
+TEST(Calibrate, RobotGuidedOverLcm) {
+  constexpr int kPort = 7913;
+  ASSERT_TRUE(multicast_available(kPort));
+  const std::string dir = make_temp_dir();
+  const auto rig = sim::make_rig({});
+  Bus bus(test_url(kPort));
+  Eigen::Vector3d ball = Eigen::Vector3d::Zero();
+  int64_t executed = -1, commands = 0;
+  bool moving = false;
+  auto arrive_at = std::chrono::steady_clock::now();
+  bus.subscribe<stereograsp::arm_cmd_t>("ARM_COMMAND", [&](const auto& c, const auto&) {
+    ball = {c.position[0], c.position[1], c.position[2]};
+    executed = c.sequence;
+    moving = true;
+    ++commands;
+    arrive_at = std::chrono::steady_clock::now() + 50ms;
+  });
+  Child calibrate({program("sg-calibrate"), "robot", "--out", dir + "/robot.yaml", "--settle",
+                   "0.05", "--frames-per-stop", "5", "--timeout", "10", "--lcm-url",
+                   test_url(kPort)});
+  std::mt19937 rng(2);
+  std::normal_distribution<double> noise(0, 0.2);
+  const auto deadline = std::chrono::steady_clock::now() + 90s;
+  while (calibrate.running() && std::chrono::steady_clock::now() < deadline) {
+    bus.handle(5ms);
+    if (moving && std::chrono::steady_clock::now() >= arrive_at) moving = false;
+    stereograsp::arm_status_t s{};
+    s.utime = now_utime();
+    s.state =
+        moving ? stereograsp::arm_status_t::STATE_MOVING : stereograsp::arm_status_t::STATE_IDLE;
+    s.last_executed_sequence = moving ? executed - 1 : executed;
+    bus.publish("ARM_STATUS", s);
+    for (int c = 0; c < 2 && executed >= 0; ++c) {
+      stereograsp::blob_t b{};
+      b.utime = now_utime();
+      b.camera = static_cast<int8_t>(c);
+      b.found = 1;
+      const Eigen::Vector2d px = *rig[static_cast<size_t>(c)].project(ball);
+      b.centroid[0] = px.x() + noise(rng), b.centroid[1] = px.y() + noise(rng);
+      bus.publish(c == 0 ? "BLOB_LEFT" : "BLOB_RIGHT", b);
+    }
+  }
+  const ProcessResult r = calibrate.wait(5s);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("18 stops (0 skipped"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("stop 18 of 18: collecting"), std::string::npos) << "progress lines";
+  EXPECT_EQ(commands, 18);
+  const auto c = vision::read_calibration(dir + "/robot.yaml");
+  double sum = 0;
+  const auto points = workspace(50, 31);
+  for (const auto& p : points) {
+    sum += (vision::triangulate({&c.left, &c.right}, {*rig[0].project(p), *rig[1].project(p)})
+                .position -
+            p)
+               .squaredNorm();
+  }
+  EXPECT_LT(std::sqrt(sum / static_cast<double>(points.size())), 0.002);
+}
+
+}  // namespace
+}  // namespace sg::test

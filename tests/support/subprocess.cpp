@@ -68,6 +68,11 @@ Child::~Child() {
   }
 }
 
+bool Child::running() {
+  if (!reaped_ && waitpid(pid_, &status_, WNOHANG) == pid_) reaped_ = true;
+  return !reaped_;
+}
+
 void Child::signal(int signum) {
   if (!reaped_) kill(pid_, signum);
 }
@@ -75,7 +80,7 @@ void Child::signal(int signum) {
 ProcessResult Child::wait(std::chrono::milliseconds timeout) {
   ProcessResult result;
   const auto deadline = std::chrono::steady_clock::now() + timeout;
-  int status = 0;
+  int status = status_;
   while (!reaped_) {
     const pid_t done = waitpid(pid_, &status, WNOHANG);
     if (done == pid_) {

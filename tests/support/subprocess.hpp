@@ -25,6 +25,9 @@ class Child {
   Child(const Child&) = delete;
   Child& operator=(const Child&) = delete;
 
+  /// True while the child has not exited (its exit status is kept for wait()).
+  bool running();
+
   /// Sends a signal (SIGINT to stop lcm-logger cleanly, say).
   void signal(int signum);
 
@@ -36,6 +39,7 @@ class Child {
  private:
   pid_t pid_ = -1;
   bool reaped_ = false;
+  int status_ = 0;
   std::string out_path_;
   std::string err_path_;
 };
