@@ -114,13 +114,14 @@ class StereoVision {
     const double nan = std::nan("");
     for (int i = 0; i < 3; ++i) p.position[i] = p.position_sigma[i] = nan;
     p.reprojection_error = nan;
-    if (p.visible) {
-      const auto t = sg::vision::triangulate_linear(
-          calibration_->left, {o[0].blob.centroid.x, o[0].blob.centroid.y}, calibration_->right,
-          {o[1].blob.centroid.x, o[1].blob.centroid.y});
-      for (int i = 0; i < 3; ++i) p.position[i] = t.position[i];
+    if (p.visible) {  // eq. 26, refined on the reprojection error, with its uncertainty
+      const auto t = sg::vision::triangulate({&calibration_->left, &calibration_->right},
+                                             {{o[0].blob.centroid.x, o[0].blob.centroid.y},
+                                              {o[1].blob.centroid.x, o[1].blob.centroid.y}});
+      for (int i = 0; i < 3; ++i) p.position[i] = t.position[i], p.position_sigma[i] = t.sigma[i];
       p.reprojection_error = t.reprojection_error;
       if (t.behind_camera) p.flags |= point3_t::FLAG_BEHIND_CAMERA;
+      if (t.near_parallel) p.flags |= point3_t::FLAG_NEAR_PARALLEL_RAYS;
       if (t.reprojection_error > 3.0) p.flags |= point3_t::FLAG_LARGE_RESIDUAL;
     }
     bus_.publish("OBJECT_POSITION", p);

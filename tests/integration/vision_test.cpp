@@ -75,6 +75,9 @@ TEST(Vision, PositionsFromSimulatedCamerasMatchTheTruth) {
                                     p.position[2] - t.position[2]);
     worst = std::max(worst, error);
     EXPECT_LT(p.reprojection_error, 1.0);
+    EXPECT_EQ(p.flags, 0);
+    EXPECT_GT(p.position_sigma[0], 0.0);
+    EXPECT_LT(p.position_sigma[0], 0.005);
   }
   EXPECT_LT(worst, 0.005);
   std::printf("worst 3D error over 30 frames: %.2f mm\n", worst * 1000);
