@@ -1,0 +1,135 @@
+#include "predictor/axis_model.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <deque>
+#include <numeric>
+
+#include "predictor/burg.hpp"
+
+namespace sg::predictor {
+namespace {
+
+class BurgAxis : public AxisModel {
+ public:
+  explicit BurgAxis(const BurgParams& p) : p_(p), a_(p.initial_coefficients) {
+    buffer_.reserve(static_cast<size_t>(p.window));
+    centred_.reserve(static_cast<size_t>(p.window));
+  }
+
+  void push(double value, bool measured) override {
+    history_.push_back(value);
+    if (static_cast<int>(history_.size()) > p_.window) history_.pop_front();
+    if (measured) estimate();
+  }
+
+  void replace_newest(const std::vector<double>& values) override {
+    const size_t n = std::min(values.size(), history_.size());
+    for (size_t i = 0; i < n; ++i)
+      history_[history_.size() - n + i] = values[values.size() - n + i];
+    estimate();
+  }
+
+  std::vector<double> forecast(int horizon) const override {
+    std::vector<double> out;
+    if (history_.empty()) return out;
+    const double m = mean();
+    std::vector<double> s;  // centred history, then the forecasts appended
+    // The last p samples (at least the newest: without coefficients yet, the forecast holds it).
+    const size_t keep = std::max<size_t>(a_.size(), 1);
+    const size_t start = history_.size() > keep ? history_.size() - keep : 0;
+    for (size_t i = start; i < history_.size(); ++i) s.push_back(history_[i] - m);
+    for (int h = 0; h < horizon; ++h) {
+      const double next =
+          a_.empty() ? s.back() : predict_next(a_, s.data(), static_cast<int>(s.size()));
+      s.push_back(next);
+      out.push_back(next + m);
+    }
+    return out;
+  }
+
+ private:
+  double mean() const {
+    if (!p_.remove_mean || history_.empty()) return 0.0;
+    return std::accumulate(history_.begin(), history_.end(), 0.0) /
+           static_cast<double>(history_.size());
+  }
+
+  void estimate() {
+    if (static_cast<int>(history_.size()) < p_.order + 3) return;  // keep the offline coefficients
+    const double m = mean();
+    centred_.assign(history_.begin(), history_.end());
+    for (double& v : centred_) v -= m;
+    a_ = burg(centred_.data(), static_cast<int>(centred_.size()), p_.order).coefficients;
+  }
+
+  BurgParams p_;
+  std::vector<double> a_;
+  std::deque<double> history_;
+  std::vector<double> buffer_, centred_;
+};
+
+class KalmanAxis : public AxisModel {
+ public:
+  explicit KalmanAxis(const KalmanParams& p) : p_(p) {
+    const double T = p.period;
+    F_ << 1, T, 0, 1;
+    Q_ << T * T * T / 3, T * T / 2, T * T / 2, T;
+    Q_ *= p.q;
+  }
+  void push(double value, bool measured) override {
+    if (!initialised_) {
+      x_ << value, 0;
+      P_ << p_.r * p_.r, 0, 0, 1.0;
+      initialised_ = true;
+      return;
+    }
+    x_ = F_ * x_;
+    P_ = F_ * P_ * F_.transpose() + Q_;
+    if (!measured) return;  // coasting through an occlusion
+    const double innovation = value - x_[0];
+    const double S = P_(0, 0) + p_.r * p_.r;
+    const Eigen::Vector2d K = P_.col(0) / S;
+    x_ += K * innovation;
+    P_ = (Eigen::Matrix2d::Identity() - K * Eigen::RowVector2d(1, 0)) * P_;
+  }
+  void replace_newest(const std::vector<double>&) override {}  // its state already coasted
+  std::vector<double> forecast(int horizon) const override {
+    std::vector<double> out;
+    for (int h = 1; h <= horizon && initialised_; ++h) out.push_back(x_[0] + x_[1] * p_.period * h);
+    return out;
+  }
+
+ private:
+  KalmanParams p_;
+  Eigen::Matrix2d F_, Q_, P_;
+  Eigen::Vector2d x_ = Eigen::Vector2d::Zero();
+  bool initialised_ = false;
+};
+
+class HoldAxis : public AxisModel {
+ public:
+  void push(double value, bool measured) override {
+    if (measured || !has_) last_ = value, has_ = true;
+  }
+  void replace_newest(const std::vector<double>&) override {}
+  std::vector<double> forecast(int horizon) const override {
+    return has_ ? std::vector<double>(static_cast<size_t>(horizon), last_) : std::vector<double>{};
+  }
+
+ private:
+  double last_ = 0;
+  bool has_ = false;
+};
+
+}  // namespace
+
+std::unique_ptr<AxisModel> make_burg_axis(const BurgParams& p) {
+  return std::make_unique<BurgAxis>(p);
+}
+std::unique_ptr<AxisModel> make_kalman_axis(const KalmanParams& p) {
+  return std::make_unique<KalmanAxis>(p);
+}
+std::unique_ptr<AxisModel> make_hold_axis() { return std::make_unique<HoldAxis>(); }
+
+}  // namespace sg::predictor

@@ -1,0 +1,46 @@
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace sg::predictor {
+
+/// One axis of the trajectory, sampled on the predictor's fixed period.
+class AxisModel {
+ public:
+  virtual ~AxisModel() = default;
+  /// Appends the newest sample: a measurement, or (measured = false) a prediction fed back
+  /// through an occlusion, which must not teach the model anything.
+  virtual void push(double value, bool measured) = 0;
+  /// The value h = 1 .. horizon samples ahead of the newest.
+  virtual std::vector<double> forecast(int horizon) const = 0;
+  /// Replaces the newest `values.size()` samples (fed-back ones, once real measurements return).
+  virtual void replace_newest(const std::vector<double>& values) = 0;
+};
+
+/// Burg's linear predictor (section 5.5): a sliding window of the last `window` samples with their
+/// mean removed; the coefficients are re-estimated at every measured sample once the window holds
+/// more than order + 3 (online adaptation), starting from offline-trained ones; forecasts apply
+/// eq. 27 recursively, feeding each prediction back.
+struct BurgParams {
+  int order = 12;
+  int window = 480;
+  bool remove_mean = true;
+  std::vector<double> initial_coefficients;  ///< a_1 .. a_p trained offline (may be empty)
+};
+std::unique_ptr<AxisModel> make_burg_axis(const BurgParams& params);
+
+/// A constant-velocity Kalman filter: state (position, velocity), white-acceleration process
+/// noise of spectral density `q` (m^2/s^3), measurement noise `r` (m, standard deviation).
+struct KalmanParams {
+  double period = 0.25;
+  double q = 1e-4;
+  double r = 0.001;
+};
+std::unique_ptr<AxisModel> make_kalman_axis(const KalmanParams& params);
+
+/// Holds the last value.
+std::unique_ptr<AxisModel> make_hold_axis();
+
+}  // namespace sg::predictor

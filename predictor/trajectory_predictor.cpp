@@ -1,0 +1,140 @@
+#include "predictor/trajectory_predictor.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace sg::predictor {
+
+Model model_from_name(const std::string& name) {
+  if (name == "burg") return Model::kBurg;
+  if (name == "kalman") return Model::kKalman;
+  if (name == "hold") return Model::kHold;
+  throw std::invalid_argument("unknown model '" + name + "' (burg, kalman or hold)");
+}
+
+const char* model_name(Model m) {
+  return m == Model::kBurg ? "burg" : m == Model::kKalman ? "kalman" : "hold";
+}
+
+TrajectoryPredictor::TrajectoryPredictor(const PredictorParams& p) : params_(p) {
+  if (p.period_us <= 0 || p.horizon < 1 || p.max_gap < 0)
+    throw std::invalid_argument("predictor: period, horizon and max_gap must be positive");
+  if (p.model == Model::kBurg && (p.burg.order < 1 || p.burg.window < p.burg.order + 3))
+    throw std::invalid_argument("predictor: the window must hold more than order + 3 samples");
+  params_.kalman.period = static_cast<double>(p.period_us) * 1e-6;
+  reset();
+}
+
+void TrajectoryPredictor::reset() {
+  for (int i = 0; i < 3; ++i) {
+    BurgParams b = params_.burg;
+    if (!params_.initial_coefficients[static_cast<size_t>(i)].empty())
+      b.initial_coefficients = params_.initial_coefficients[static_cast<size_t>(i)];
+    axes_[static_cast<size_t>(i)] = params_.model == Model::kBurg ? make_burg_axis(b)
+                                    : params_.model == Model::kKalman
+                                        ? make_kalman_axis(params_.kalman)
+                                        : make_hold_axis();
+  }
+  started_ = false;
+  have_seen_ = false;
+  occluded_ = 0;
+}
+
+Eigen::Vector3d TrajectoryPredictor::one_step() const {
+  Eigen::Vector3d p;
+  for (int i = 0; i < 3; ++i) p[i] = axes_[static_cast<size_t>(i)]->forecast(1).front();
+  return p;
+}
+
+Forecast TrajectoryPredictor::emit_sample(int64_t grid, const Eigen::Vector3d& value, bool measured,
+                                          int64_t source) {
+  if (measured && occluded_ > 0) {  // back from an occlusion: the gap becomes the straight line
+    for (int i = 0; i < 3; ++i) {
+      std::vector<double> line;
+      for (int k = 1; k <= occluded_; ++k) {
+        const double s = static_cast<double>(k) / (occluded_ + 1);
+        line.push_back(last_real_value_[i] + s * (value[i] - last_real_value_[i]));
+      }
+      axes_[static_cast<size_t>(i)]->replace_newest(line);
+    }
+    occluded_ = 0;
+  }
+  for (int i = 0; i < 3; ++i) axes_[static_cast<size_t>(i)]->push(value[i], measured);
+  if (measured) {
+    last_real_grid_ = grid;
+    last_real_value_ = value;
+    status_ = TrackStatus::kTracking;
+  } else {
+    ++occluded_;
+    status_ = TrackStatus::kOccluded;
+  }
+  Forecast f;
+  f.utime = grid;
+  f.source_utime = source;
+  f.period_us = params_.period_us;
+  f.occluded_samples = occluded_;
+  f.status = status_;
+  std::array<std::vector<double>, 3> axis;
+  for (int i = 0; i < 3; ++i)
+    axis[static_cast<size_t>(i)] = axes_[static_cast<size_t>(i)]->forecast(params_.horizon);
+  for (int h = 0; h < params_.horizon; ++h) {
+    f.positions.emplace_back(axis[0][static_cast<size_t>(h)], axis[1][static_cast<size_t>(h)],
+                             axis[2][static_cast<size_t>(h)]);
+  }
+  return f;
+}
+
+std::vector<Forecast> TrajectoryPredictor::add(const Measurement& m) {
+  std::vector<Forecast> out;
+  if ((m.visible && !m.position.allFinite()) || (started_ && m.utime <= last_utime_)) {
+    ++rejected_;
+    return out;
+  }
+  last_utime_ = m.utime;
+  if (!started_) {
+    if (!m.visible) return out;  // nothing to predict from yet
+    started_ = true;
+    next_grid_ = m.utime;
+  }
+  // Grid samples up to this measurement's time: interpolated between two visible measurements
+  // close in time, fed back otherwise.
+  while (next_grid_ <= m.utime) {
+    const bool interpolate =
+        m.visible && have_seen_ && m.utime - seen_utime_ <= 2 * params_.period_us;
+    if (next_grid_ == m.utime && m.visible) {
+      out.push_back(emit_sample(next_grid_, m.position, true, m.utime));
+    } else if (interpolate && next_grid_ >= seen_utime_) {
+      const double s = static_cast<double>(next_grid_ - seen_utime_) /
+                       static_cast<double>(m.utime - seen_utime_);
+      out.push_back(emit_sample(next_grid_, seen_position_ + s * (m.position - seen_position_),
+                                true, m.utime));
+    } else {
+      if (occluded_ >= params_.max_gap) {  // lost: start again from the next sighting
+        Forecast lost;
+        lost.utime = next_grid_;
+        lost.source_utime = m.utime;
+        lost.period_us = params_.period_us;
+        lost.occluded_samples = occluded_;
+        lost.status = status_ = TrackStatus::kLost;
+        out.push_back(lost);
+        reset();
+        if (m.visible) {
+          started_ = true;
+          next_grid_ = m.utime;
+          continue;
+        }
+        return out;
+      }
+      out.push_back(emit_sample(next_grid_, one_step(), false, m.utime));
+    }
+    next_grid_ += params_.period_us;
+  }
+  if (m.visible) {
+    have_seen_ = true;
+    seen_utime_ = m.utime;
+    seen_position_ = m.position;
+  }
+  return out;
+}
+
+}  // namespace sg::predictor

@@ -1,0 +1,228 @@
+// Burg's method against Octave's arburg, and the predictor's behaviour with known answers.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "predictor/burg.hpp"
+#include "predictor/trajectory_predictor.hpp"
+
+namespace sg::predictor {
+namespace {
+
+struct Reference {
+  std::string name;
+  int order = 0;
+  std::vector<double> x, a, k;
+  double v = 0;
+};
+
+std::vector<Reference> load_reference() {
+  std::ifstream file(std::string(SG_SOURCE_DIR) + "/tests/fixtures/burg/arburg_reference.txt");
+  std::vector<Reference> out;
+  std::string line;
+  auto numbers = [](std::istringstream& in) {
+    std::vector<double> v;
+    double d;
+    while (in >> d) v.push_back(d);
+    return v;
+  };
+  while (std::getline(file, line)) {
+    std::istringstream in(line);
+    std::string tag;
+    in >> tag;
+    if (tag == "signal") {
+      out.emplace_back();
+      int n;
+      in >> out.back().name >> n >> out.back().order;
+    } else if (tag == "x") {
+      out.back().x = numbers(in);
+    } else if (tag == "a") {
+      out.back().a = numbers(in);
+    } else if (tag == "k") {
+      out.back().k = numbers(in);
+    } else if (tag == "v") {
+      in >> out.back().v;
+    }
+  }
+  return out;
+}
+
+// Coefficients, reflection coefficients and error power equal Octave's arburg to 1e-9 on noisy
+// signals (tests/fixtures/burg, with the script that made them).
+TEST(Burg, MatchesOctavesArburg) {
+  const auto references = load_reference();
+  ASSERT_EQ(references.size(), 5u);
+  for (const Reference& r : references) {
+    const BurgResult b = burg(r.x.data(), static_cast<int>(r.x.size()), r.order);
+    ASSERT_EQ(b.coefficients.size() + 1, r.a.size()) << r.name;
+    EXPECT_DOUBLE_EQ(r.a[0], 1.0);
+    for (int i = 0; i < r.order; ++i) {
+      EXPECT_NEAR(b.coefficients[static_cast<size_t>(i)], r.a[static_cast<size_t>(i + 1)], 1e-9)
+          << r.name << " a" << i + 1;
+      EXPECT_NEAR(b.reflection_coeffs[static_cast<size_t>(i)], r.k[static_cast<size_t>(i)], 1e-9)
+          << r.name << " k" << i + 1;
+    }
+    EXPECT_NEAR(b.error_power.back() / r.v, 1.0, 1e-9) << r.name;
+  }
+}
+
+// The prediction error power never increases with the order (the guard against the paper's sign
+// error in eq. 30-32, which breaks every order above 1).
+TEST(Burg, ErrorPowerNeverIncreasesWithOrder) {
+  for (const Reference& r : load_reference()) {
+    const BurgResult b = burg(r.x.data(), static_cast<int>(r.x.size()),
+                              std::min(20, static_cast<int>(r.x.size()) - 1));
+    for (size_t k = 1; k < b.error_power.size(); ++k) {
+      EXPECT_LE(b.error_power[k], b.error_power[k - 1] * (1 + 1e-12)) << r.name << " order " << k;
+      EXPECT_LE(std::abs(b.reflection_coeffs[k - 1]), 1.0) << r.name;
+    }
+  }
+}
+
+// A noise-free sinusoid is an AR(2) process, x_n = 2 cos(w) x_{n-1} - x_{n-2}: order 2 forecasts
+// it exactly 16 steps ahead. Burg's r_1 is exactly -cos(w) when the window's N - 1 lag products
+// span whole periods (here 3 periods of 37 samples, N = 112); r_2 = 1 then follows exactly, as the
+// order-1 forward and backward errors of a sinusoid are each other's negatives.
+TEST(Burg, ForecastsANoiseFreeAr2Exactly) {
+  BurgParams p;
+  p.order = 2;
+  p.window = 112;
+  p.remove_mean = false;
+  auto axis = make_burg_axis(p);
+  const double w = 2 * M_PI / 37;
+  for (int n = 0; n < 112; ++n) axis->push(std::cos(w * n + 0.4), true);
+  const auto f = axis->forecast(16);
+  for (int h = 1; h <= 16; ++h)
+    EXPECT_NEAR(f[static_cast<size_t>(h - 1)], std::cos(w * (111 + h) + 0.4), 1e-9) << h;
+  const std::vector<double> x = [&] {
+    std::vector<double> v;
+    for (int n = 0; n < 112; ++n) v.push_back(std::cos(w * n + 0.4));
+    return v;
+  }();
+  const BurgResult b = burg(x.data(), 112, 2);
+  EXPECT_NEAR(b.coefficients[0], -2 * std::cos(w), 1e-12);
+  EXPECT_NEAR(b.coefficients[1], 1.0, 1e-12);
+}
+
+// A constant signal (a still ball, or Z of a horizontal circle) gives finite output: itself.
+TEST(Burg, ConstantSignalIsFinite) {
+  const std::vector<double> still(100, 0.45);
+  const BurgResult b = burg(still.data(), 100, 12);
+  for (double a : b.coefficients) EXPECT_TRUE(std::isfinite(a));
+  for (bool remove_mean : {true, false}) {
+    BurgParams p;
+    p.remove_mean = remove_mean;
+    auto axis = make_burg_axis(p);
+    for (int i = 0; i < 100; ++i) axis->push(0.45, true);
+    for (double v : axis->forecast(16)) EXPECT_NEAR(v, 0.45, 1e-12);
+  }
+}
+
+PredictorParams params_4hz() {
+  PredictorParams p;
+  p.burg.window = 240;
+  return p;
+}
+
+Eigen::Vector3d circle(double t) {
+  return {0.45 + 0.15 * std::cos(2 * M_PI * t / 60), 0.15 * std::sin(2 * M_PI * t / 60), 0.10};
+}
+
+constexpr int64_t kT0 = 1'700'000'000'000'000;
+
+// Occlusion: fed-back samples carry the track (status OCCLUDED, counted), stay near the truth,
+// and the track recovers when the ball is seen again; after 16 fed-back samples it is lost.
+TEST(Predictor, OcclusionFeedbackRecoveryAndLoss) {
+  TrajectoryPredictor predictor(params_4hz());
+  int64_t k = 0;
+  auto step = [&](bool visible) {
+    const double t = static_cast<double>(k) * 0.25;
+    auto out = predictor.add({kT0 + k * 250'000, visible, circle(t)});
+    ++k;
+    return out;
+  };
+  for (int i = 0; i < 300; ++i) step(true);
+  double worst = 0;
+  for (int i = 1; i <= 10; ++i) {
+    const auto f = step(false);
+    ASSERT_EQ(f.size(), 1u);
+    EXPECT_EQ(f[0].status, TrackStatus::kOccluded);
+    EXPECT_EQ(f[0].occluded_samples, i);
+    worst = std::max(worst, (f[0].positions[0] - circle(static_cast<double>(k) * 0.25)).norm());
+  }
+  EXPECT_LT(worst, 0.002) << "noise-free circle through a 2.5 s occlusion";
+  auto back = step(true);
+  ASSERT_EQ(back.size(), 1u);
+  EXPECT_EQ(back[0].status, TrackStatus::kTracking);
+  EXPECT_EQ(back[0].occluded_samples, 0);
+  EXPECT_LT((back[0].positions[0] - circle(static_cast<double>(k) * 0.25)).norm(), 0.002);
+  for (int i = 0; i < 16; ++i) step(false);
+  const auto lost = step(false);
+  ASSERT_FALSE(lost.empty());
+  EXPECT_EQ(lost.back().status, TrackStatus::kLost);
+  EXPECT_EQ(predictor.status(), TrackStatus::kLost);
+  const auto again = step(true);
+  ASSERT_EQ(again.size(), 1u);
+  EXPECT_EQ(again[0].status, TrackStatus::kTracking);
+}
+
+// 30 Hz measurements become samples every 0.25 s exactly, linearly interpolated on utime.
+TEST(Predictor, ResamplesIrregularInputOntoThePeriod) {
+  PredictorParams p = params_4hz();
+  p.model = Model::kHold;  // the forecast is the newest sample itself
+  TrajectoryPredictor predictor(p);
+  std::vector<Forecast> samples;
+  for (int i = 0; i <= 300; ++i) {  // 10 s at 30 Hz, with jitter
+    const int64_t utime = kT0 + i * 33'333 + (i % 3) * 1'000;
+    for (const auto& f :
+         predictor.add({utime, true, circle(static_cast<double>(utime - kT0) * 1e-6)}))
+      samples.push_back(f);
+  }
+  ASSERT_EQ(samples.size(), 40u);
+  for (size_t i = 0; i < samples.size(); ++i) {
+    EXPECT_EQ(samples[i].utime, kT0 + static_cast<int64_t>(i) * 250'000);
+    // Linear interpolation of a circle over 33 ms: within the chord's sag (microns).
+    EXPECT_LT((samples[i].positions[0] - circle(static_cast<double>(i) * 0.25)).norm(), 2e-6) << i;
+  }
+}
+
+// NaN and infinite positions, time going backwards and a repeated utime are rejected and counted;
+// the state is untouched.
+TEST(Predictor, RejectsBadInput) {
+  TrajectoryPredictor predictor(params_4hz());
+  EXPECT_EQ(predictor.add({kT0, true, circle(0)}).size(), 1u);
+  const double nan = std::nan("");
+  EXPECT_TRUE(predictor.add({kT0 + 250'000, true, {nan, 0, 0}}).empty());
+  EXPECT_TRUE(predictor.add({kT0 + 250'000, true, {INFINITY, 0, 0}}).empty());
+  EXPECT_TRUE(predictor.add({kT0 - 1, true, circle(0)}).empty());
+  EXPECT_TRUE(predictor.add({kT0, true, circle(0)}).empty());
+  EXPECT_EQ(predictor.rejected(), 4u);
+  const auto next = predictor.add({kT0 + 250'000, true, circle(0.25)});
+  ASSERT_EQ(next.size(), 1u);
+  EXPECT_EQ(next[0].utime, kT0 + 250'000);
+  EXPECT_TRUE(predictor.add({kT0 + 250'000 + 1, false, {nan, nan, nan}}).empty())
+      << "an invisible NaN is fine";
+  EXPECT_EQ(predictor.rejected(), 4u);
+}
+
+// The baselines behind the same interface: Kalman follows a line exactly, hold holds.
+TEST(Predictor, Baselines) {
+  PredictorParams p = params_4hz();
+  p.model = Model::kKalman;
+  TrajectoryPredictor kalman(p);
+  Forecast last;
+  for (int i = 0; i < 200; ++i) {
+    for (const auto& f :
+         kalman.add({kT0 + i * 250'000, true, Eigen::Vector3d(0.01 * i * 0.25, 0, 0)}))
+      last = f;
+  }
+  EXPECT_NEAR(last.positions[15].x(), 0.01 * (199 + 16) * 0.25, 1e-4);
+  EXPECT_EQ(model_from_name("hold"), Model::kHold);
+  EXPECT_THROW(model_from_name("lstm"), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace sg::predictor
