@@ -20,7 +20,12 @@ class BurgAxis : public AxisModel {
   void push(double value, bool measured) override {
     history_.push_back(value);
     if (static_cast<int>(history_.size()) > p_.window) history_.pop_front();
-    if (measured) estimate();
+    // The mean and the coefficients are learnt from measurements only: through an occlusion they
+    // stay as they were, and the fed-back samples continue the forecast made at its start.
+    if (measured) {
+      mean_ = window_mean();
+      estimate();
+    }
   }
 
   void replace_newest(const std::vector<double>& values) override {
@@ -33,7 +38,7 @@ class BurgAxis : public AxisModel {
   std::vector<double> forecast(int horizon) const override {
     std::vector<double> out;
     if (history_.empty()) return out;
-    const double m = mean();
+    const double m = mean_;
     std::vector<double> s;  // centred history, then the forecasts appended
     // The last p samples (at least the newest: without coefficients yet, the forecast holds it).
     const size_t keep = std::max<size_t>(a_.size(), 1);
@@ -49,7 +54,7 @@ class BurgAxis : public AxisModel {
   }
 
  private:
-  double mean() const {
+  double window_mean() const {
     if (!p_.remove_mean || history_.empty()) return 0.0;
     return std::accumulate(history_.begin(), history_.end(), 0.0) /
            static_cast<double>(history_.size());
@@ -57,7 +62,7 @@ class BurgAxis : public AxisModel {
 
   void estimate() {
     if (static_cast<int>(history_.size()) < p_.order + 3) return;  // keep the offline coefficients
-    const double m = mean();
+    const double m = mean_;
     centred_.assign(history_.begin(), history_.end());
     for (double& v : centred_) v -= m;
     a_ = burg(centred_.data(), static_cast<int>(centred_.size()), p_.order).coefficients;
@@ -66,6 +71,7 @@ class BurgAxis : public AxisModel {
   BurgParams p_;
   std::vector<double> a_;
   std::deque<double> history_;
+  double mean_ = 0.0;
   std::vector<double> buffer_, centred_;
 };
 

@@ -74,6 +74,7 @@ Forecast TrajectoryPredictor::emit_sample(int64_t grid, const Eigen::Vector3d& v
   f.period_us = params_.period_us;
   f.occluded_samples = occluded_;
   f.status = status_;
+  f.sample = value;
   std::array<std::vector<double>, 3> axis;
   for (int i = 0; i < 3; ++i)
     axis[static_cast<size_t>(i)] = axes_[static_cast<size_t>(i)]->forecast(params_.horizon);

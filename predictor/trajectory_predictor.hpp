@@ -40,6 +40,8 @@ struct Forecast {
   int64_t utime = 0;         ///< time of the newest grid sample
   int64_t source_utime = 0;  ///< the measurement that produced it
   int64_t period_us = 0;
+  Eigen::Vector3d sample =
+      Eigen::Vector3d::Zero();             ///< the newest grid sample (fed back if occluded)
   std::vector<Eigen::Vector3d> positions;  ///< at utime + h * period_us, h = 1 .. horizon
   int occluded_samples = 0;                ///< fed-back samples at the end of the history
   TrackStatus status = TrackStatus::kNone;
