@@ -1,0 +1,58 @@
+// The predictor's cost per sample: one update (Burg re-estimated on the window) plus the 16-step
+// forecast of all three axes, at p = 12 and W = 480; beside it, the Kalman baseline and a copy of
+// the window (the least an online re-estimation must touch) in the same run.
+//
+//   build/bin/predictor_bench
+// Goal (issue 6): at most 20 microseconds per sample for Burg.
+
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <deque>
+
+#include "predictor/trajectory_predictor.hpp"
+
+namespace {
+
+using sg::predictor::Model;
+
+Eigen::Vector3d paper(double t) {
+  return {0.45 + 0.15 * std::cos(2 * M_PI * t / 60),
+          0.15 * std::sin(2 * M_PI * t / 60) + 0.001 * std::sin(7 * t), 0.1};
+}
+
+void run(benchmark::State& state, Model model) {
+  sg::predictor::PredictorParams p;
+  p.model = model;
+  p.burg.order = 12;
+  p.burg.window = 480;
+  sg::predictor::TrajectoryPredictor predictor(p);
+  int64_t k = 0;
+  for (; k < 600; ++k)
+    predictor.add({1'000'000 + k * 250'000, true, paper(k * 0.25)});  // window full
+  for (auto _ : state) {
+    const auto f = predictor.add({1'000'000 + k * 250'000, true, paper(k * 0.25)});
+    benchmark::DoNotOptimize(f.data());
+    ++k;
+  }
+}
+
+void BM_Sample_Burg(benchmark::State& state) { run(state, Model::kBurg); }
+void BM_Sample_Kalman(benchmark::State& state) { run(state, Model::kKalman); }
+BENCHMARK(BM_Sample_Burg)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Sample_Kalman)->Unit(benchmark::kMicrosecond);
+
+// Baseline: copying three windows of 480 samples.
+void BM_Sample_CopyThreeWindows(benchmark::State& state) {
+  std::deque<double> window(480, 1.0);
+  std::vector<double> out(480);
+  for (auto _ : state) {
+    for (int axis = 0; axis < 3; ++axis) std::copy(window.begin(), window.end(), out.begin());
+    benchmark::DoNotOptimize(out.data());
+  }
+}
+BENCHMARK(BM_Sample_CopyThreeWindows)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
