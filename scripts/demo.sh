@@ -7,9 +7,11 @@
 # (sg-bus-check); then the simulated stereo cameras (sg-camera-sim) film the red ball on the
 # paper's path -- a 0.15 m circle at 1 rpm plus a drift along Y, hidden by a passing panel for two
 # seconds -- at 30 Hz; sg-vision finds the ball in both images and triangulates it with the
-# cameras' calibration (BLOB_LEFT, BLOB_RIGHT, OBJECT_POSITION); sg-viewer records the paper's
-# user interface to a video. The stock lcm-logger records the session into logs/ (camera images
-# only with --with-images: they are large). Prediction, the arm and grasping join as they land.
+# cameras' calibration (BLOB_LEFT, BLOB_RIGHT, OBJECT_POSITION); sg-predictor forecasts its path
+# 16 samples (4 s) ahead with Burg's linear predictors, carrying it through the occlusion
+# (OBJECT_TRAJECTORY); sg-viewer records the paper's user interface, the prediction drawn in, to a
+# video. The stock lcm-logger records the session into logs/ (camera images only with
+# --with-images: they are large). The arm and grasping join as they land.
 #
 # The bus is LCM's default (or $LCM_DEFAULT_URL), so `scripts/spy.sh` in another terminal shows
 # the channels while the demo runs.
@@ -74,25 +76,29 @@ echo "demo: 2. the cameras' calibration (the simulator's own: robot-guided calib
 "$bin/sg-camera-sim" --snapshot "$session.pair.png" --snapshot-frame 60 \
   --calibration-out "$session.calibration.yaml" --log-level warn | sed 's/^/   /'
 
-echo "demo: 3. cameras -> vision -> viewer: the paper's motion at 30 Hz for $seconds s, occluded from 4 to 6 s"
+echo "demo: 3. cameras -> vision -> predictor -> viewer: the paper's motion at 30 Hz for $seconds s, occluded from 4 to 6 s"
 "$bin/sg-vision" --calibration "$session.calibration.yaml" --log-level warn "${url_args[@]}" \
   > "$session.vision.txt" &
 vision_pid=$!
+"$bin/sg-predictor" --log-level warn "${url_args[@]}" > "$session.predictor.txt" &
+predictor_pid=$!
 "$bin/sg-viewer" --record "$session.view.avi" --no-window --calibration "$session.calibration.yaml" \
   --log-level warn "${url_args[@]}" > "$session.viewer.txt" &
 viewer_pid=$!
-pids+=("$vision_pid" "$viewer_pid")
+pids+=("$vision_pid" "$predictor_pid" "$viewer_pid")
 sleep 1
 "$bin/sg-camera-sim" --frames "$frames" --occlusion 4:2 --log-level warn "${url_args[@]}" \
   | sed 's/^/   sg-camera-sim: /' || status=1
 sleep 1
-kill -INT "$vision_pid" "$viewer_pid"
+kill -INT "$vision_pid" "$predictor_pid" "$viewer_pid"
 wait "$vision_pid" || status=1
+wait "$predictor_pid" || status=1
 wait "$viewer_pid" || status=1
 pids=("$logger_pid")
 echo "   sg-vision: $(cat "$session.vision.txt")"
+echo "   sg-predictor: $(cat "$session.predictor.txt")"
 echo "   sg-viewer: $(cat "$session.viewer.txt")"
-rm -f "$session.vision.txt" "$session.viewer.txt"
+rm -f "$session.vision.txt" "$session.predictor.txt" "$session.viewer.txt"
 
 sleep 0.5
 kill -INT "$logger_pid"
