@@ -9,6 +9,7 @@
 #include <cstring>
 #include <map>
 
+#include "bench/timing_reporter.hpp"
 #include "common/bus.hpp"
 #include "common/message_types.hpp"
 
@@ -106,36 +107,18 @@ void BM_Trajectory_BusRoundMemq(benchmark::State& state) {
 }
 BENCHMARK(BM_Trajectory_BusRoundMemq);
 
-/// Collects each benchmark's time per iteration while the console prints the usual table.
-class RatioReporter : public benchmark::ConsoleReporter {
- public:
-  void ReportRuns(const std::vector<Run>& runs) override {
-    for (const Run& run : runs) ns_[run.benchmark_name()] = run.GetAdjustedRealTime();
-    ConsoleReporter::ReportRuns(runs);
-  }
-  void PrintRatios() const {
+}  // namespace
+
+// After the table: each case as a ratio to its group's CopyBaseline (BM_<Group>_...).
+int main(int argc, char** argv) {
+  return sg::bench::run_benchmarks(argc, argv, [](const sg::bench::TimingReporter& r) {
     std::printf("\nratio to baseline (same run; lower is cheaper):\n");
-    for (const auto& [name, ns] : ns_) {
+    for (const auto& [name, ns] : r.times()) {
       const std::string group = name.substr(0, name.find('_', 3) + 1);
-      const auto base = ns_.find(group + "CopyBaseline");
-      if (base == ns_.end() || base->first == name) continue;
+      const auto base = r.times().find(group + "CopyBaseline");
+      if (base == r.times().end() || base->first == name) continue;
       std::printf("  %-32s %10.1f ns  %6.2fx %s\n", name.c_str(), ns, ns / base->second,
                   base->first.c_str());
     }
-  }
-
- private:
-  std::map<std::string, double> ns_;
-};
-
-}  // namespace
-
-int main(int argc, char** argv) {
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  RatioReporter reporter;
-  benchmark::RunSpecifiedBenchmarks(&reporter);
-  reporter.PrintRatios();
-  benchmark::Shutdown();
-  return 0;
+  });
 }

@@ -12,6 +12,7 @@
 #include <map>
 #include <opencv2/imgproc.hpp>
 
+#include "bench/timing_reporter.hpp"
 #include "sim/camera_simulator.hpp"
 #include "vision/blob_tracker.hpp"
 
@@ -94,38 +95,16 @@ BENCHMARK(BM_Pair_OpenCvBaseline)
     ->Repetitions(5)
     ->ReportAggregatesOnly();
 
-/// Keeps the medians and prints the ratios after the table.
-class RatioReporter : public benchmark::ConsoleReporter {
- public:
-  void ReportRuns(const std::vector<Run>& runs) override {
-    for (const Run& run : runs) {
-      if (run.aggregate_name == "median")
-        median_us_[run.run_name.function_name] = run.GetAdjustedRealTime();
-    }
-    ConsoleReporter::ReportRuns(runs);
-  }
-  void PrintRatios() const {
-    const double base = median_us_.at("BM_Pair_OpenCvBaseline");
-    std::printf("\nper stereo pair (median)   time        vs OpenCV baseline   goal\n");
-    std::printf("  tracking mode        %8.1f us    %6.1fx faster       <= 100 us, >= 10x\n",
-                median_us_.at("BM_Pair_Tracking"), base / median_us_.at("BM_Pair_Tracking"));
-    std::printf("  full frame           %8.1f us    %6.1fx faster       <= 2000 us\n",
-                median_us_.at("BM_Pair_FullFrame"), base / median_us_.at("BM_Pair_FullFrame"));
-    std::printf("  OpenCV baseline      %8.1f us\n", base);
-  }
-
- private:
-  std::map<std::string, double> median_us_;
-};
-
 }  // namespace
 
 int main(int argc, char** argv) {
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  RatioReporter reporter;
-  benchmark::RunSpecifiedBenchmarks(&reporter);
-  reporter.PrintRatios();
-  benchmark::Shutdown();
-  return 0;
+  return sg::bench::run_benchmarks(argc, argv, [](const sg::bench::TimingReporter& r) {
+    const double base = r.time("BM_Pair_OpenCvBaseline");
+    std::printf("\nper stereo pair (median)   time        vs OpenCV baseline   goal\n");
+    std::printf("  tracking mode        %8.1f us    %6.1fx faster       <= 100 us, >= 10x\n",
+                r.time("BM_Pair_Tracking"), base / r.time("BM_Pair_Tracking"));
+    std::printf("  full frame           %8.1f us    %6.1fx faster       <= 2000 us\n",
+                r.time("BM_Pair_FullFrame"), base / r.time("BM_Pair_FullFrame"));
+    std::printf("  OpenCV baseline      %8.1f us\n", base);
+  });
 }

@@ -11,6 +11,7 @@
 
 #include "sim/stereo_rig.hpp"
 #include "tests/support/subprocess.hpp"
+#include "tests/support/workspace.hpp"
 #include "vision/calibration_file.hpp"
 #include "vision/registration.hpp"
 #include "vision/triangulation.hpp"
@@ -28,14 +29,6 @@ std::string slurp(const std::string& path) {
   return s.str();
 }
 
-std::vector<Eigen::Vector3d> workspace(int n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> x(0.2, 0.7), y(-0.3, 0.3), z(0.0, 0.3);
-  std::vector<Eigen::Vector3d> points;
-  for (int i = 0; i < n; ++i) points.emplace_back(x(rng), y(rng), z(rng));
-  return points;
-}
-
 // DLT from two CSV files of the simulated rig's points (0.3 px noise): a calibration file whose
 // cameras triangulate new points across the workspace within 2 mm RMS.
 TEST(Calibrate, DltFromCsv) {
@@ -46,7 +39,7 @@ TEST(Calibrate, DltFromCsv) {
   for (int c = 0; c < 2; ++c) {
     std::ofstream csv(dir + (c == 0 ? "/left.csv" : "/right.csv"));
     csv << "X,Y,Z,u,v\n# points carried by the arm\n" << std::setprecision(17);
-    for (const auto& p : workspace(30, 8)) {
+    for (const auto& p : workspace_points(30, 8)) {
       const Eigen::Vector2d px = *rig[static_cast<size_t>(c)].project(p);
       csv << p.x() << "," << p.y() << "," << p.z() << "," << px.x() + noise(rng) << ","
           << px.y() + noise(rng) << "\n";
@@ -59,7 +52,7 @@ TEST(Calibrate, DltFromCsv) {
       << r.out;
   const auto c = vision::read_calibration(dir + "/cams.yaml");
   double sum = 0;
-  const auto test_points = workspace(50, 77);
+  const auto test_points = workspace_points(50, 77);
   for (const auto& p : test_points) {
     const auto t =
         vision::triangulate({&c.left, &c.right}, {*rig[0].project(p), *rig[1].project(p)});
@@ -110,7 +103,7 @@ TEST(Calibrate, RegisterMovesTheCalibrationIntoTheRobotFrame) {
                             vision::change_world_frame(robot_frame, robot_from_camera));
   std::ofstream csv(dir + "/marks.csv");
   csv << std::setprecision(17);
-  for (const auto& p : workspace(8, 3)) {
+  for (const auto& p : workspace_points(8, 3)) {
     const Eigen::Vector2d l = *rig[0].project(p), r = *rig[1].project(p);
     csv << p.x() << "," << p.y() << "," << p.z() << "," << l.x() << "," << l.y() << "," << r.x()
         << "," << r.y() << "\n";
@@ -121,7 +114,7 @@ TEST(Calibrate, RegisterMovesTheCalibrationIntoTheRobotFrame) {
            "--points", dir + "/marks.csv", "--out", dir + "/robot.yaml"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto back = vision::read_calibration(dir + "/robot.yaml");
-  for (const auto& p : workspace(20, 90)) {
+  for (const auto& p : workspace_points(20, 90)) {
     EXPECT_LT((*back.left.project(p) - *rig[0].project(p)).norm(), 1e-6);
     EXPECT_LT((*back.right.project(p) - *rig[1].project(p)).norm(), 1e-6);
   }
@@ -227,7 +220,7 @@ TEST(Calibrate, RobotGuidedOverLcm) {
   EXPECT_EQ(commands, 18);
   const auto c = vision::read_calibration(dir + "/robot.yaml");
   double sum = 0;
-  const auto points = workspace(50, 31);
+  const auto points = workspace_points(50, 31);
   for (const auto& p : points) {
     sum += (vision::triangulate({&c.left, &c.right}, {*rig[0].project(p), *rig[1].project(p)})
                 .position -

@@ -9,6 +9,7 @@
 #include <random>
 
 #include "sim/stereo_rig.hpp"
+#include "tests/support/workspace.hpp"
 #include "vision/checkerboard.hpp"
 #include "vision/dlt.hpp"
 #include "vision/registration.hpp"
@@ -17,14 +18,7 @@
 namespace sg::vision {
 namespace {
 
-/// Points spread through the workspace (robot frame): X 0.2-0.7, Y -0.3-0.3, Z 0-0.3 m.
-std::vector<Eigen::Vector3d> workspace_points(int n, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> x(0.2, 0.7), y(-0.3, 0.3), z(0.0, 0.3);
-  std::vector<Eigen::Vector3d> points;
-  for (int i = 0; i < n; ++i) points.emplace_back(x(rng), y(rng), z(rng));
-  return points;
-}
+using test::workspace_points;
 
 std::vector<Correspondence> observe(const CameraModel& cam,
                                     const std::vector<Eigen::Vector3d>& world, double noise_px,
