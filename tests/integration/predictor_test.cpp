@@ -65,6 +65,9 @@ TEST(Predictor, ReplayedLogGivesIdenticalTrajectories) {
     for (int i = 0; i < 3; ++i) p.position[i] = p.visible ? x[i] : std::nan("");
     a.publish("OBJECT_POSITION", p);
     ++k;
+    // Paced, so neither the live stream nor its replay at recorded speed is a burst that a
+    // loaded machine's socket buffers could drop.
+    std::this_thread::sleep_for(10ms);
   });
   logger.signal(SIGINT);
   live.signal(SIGINT);
