@@ -1,6 +1,7 @@
 // The predictor's cost per sample: one update (Burg re-estimated on the window) plus the 16-step
-// forecast of all three axes, at p = 12 and W = 480; beside it, the Kalman baseline and a copy of
-// the window (the least an online re-estimation must touch) in the same run.
+// forecast, for one axis predictor and for the whole 3D trajectory predictor (three axes and the
+// resampling), at p = 12 and W = 480; beside them, the Kalman baseline and a copy of the windows
+// (the least an online re-estimation must touch) in the same run.
 //
 //   build/bin/predictor_bench
 // Goal (issue 6): at most 20 microseconds per sample for Burg.
@@ -41,6 +42,24 @@ void BM_Sample_Burg(benchmark::State& state) { run(state, Model::kBurg); }
 void BM_Sample_Kalman(benchmark::State& state) { run(state, Model::kKalman); }
 BENCHMARK(BM_Sample_Burg)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Sample_Kalman)->Unit(benchmark::kMicrosecond);
+
+// One axis predictor alone: push a measured sample (Burg re-estimated on its window) and forecast
+// 16 steps.
+void BM_Axis_Burg(benchmark::State& state) {
+  sg::predictor::BurgParams p;
+  p.order = 12;
+  p.window = 480;
+  auto axis = sg::predictor::make_burg_axis(p);
+  int64_t k = 0;
+  for (; k < 600; ++k) axis->push(paper(k * 0.25).y(), true);
+  for (auto _ : state) {
+    axis->push(paper(k * 0.25).y(), true);
+    const auto f = axis->forecast(16);
+    benchmark::DoNotOptimize(f.data());
+    ++k;
+  }
+}
+BENCHMARK(BM_Axis_Burg)->Unit(benchmark::kMicrosecond);
 
 // Baseline: copying three windows of 480 samples.
 void BM_Sample_CopyThreeWindows(benchmark::State& state) {
