@@ -22,13 +22,6 @@ namespace {
 using namespace std::chrono_literals;
 namespace fs = std::filesystem;
 
-std::string slurp(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
 // DLT from two CSV files of the simulated rig's points (0.3 px noise): a calibration file whose
 // cameras triangulate new points across the workspace within 2 mm RMS.
 TEST(Calibrate, DltFromCsv) {
@@ -129,7 +122,7 @@ TEST(Calibrate, BadInputLeavesTheGoodFile) {
   c.left = rig[0];
   c.right = rig[1];
   vision::write_calibration(good, c);
-  const std::string before = slurp(good);
+  const std::string before = read_text(good);
   std::ofstream(dir + "/bad.csv") << "X,Y,Z,u,v\n0.1,0.2,0.3,10,20\n0.1,abc,0.3,10,20\n";
   std::ofstream flat(dir + "/flat.csv");
   for (int i = 0; i < 10; ++i)
@@ -152,7 +145,7 @@ TEST(Calibrate, BadInputLeavesTheGoodFile) {
     EXPECT_EQ(r.exit_code, 1) << needle;
     EXPECT_EQ(count_lines(r.err), 1) << r.err;
     EXPECT_NE(r.err.find(needle), std::string::npos) << r.err;
-    EXPECT_EQ(slurp(good), before) << "the good file is untouched";
+    EXPECT_EQ(read_text(good), before) << "the good file is untouched";
   }
 }
 

@@ -15,16 +15,13 @@
 extern char** environ;
 
 namespace sg::test {
-namespace {
 
-std::string read_file(const std::string& path) {
+std::string read_text(const std::string& path) {
   std::ifstream file(path);
   std::stringstream text;
   text << file.rdbuf();
   return text.str();
 }
-
-}  // namespace
 
 std::string make_temp_dir() {
   const char* base = std::getenv("TMPDIR");
@@ -97,8 +94,8 @@ ProcessResult Child::wait(std::chrono::milliseconds timeout) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  result.out = read_file(out_path_);
-  result.err = read_file(err_path_);
+  result.out = read_text(out_path_);
+  result.err = read_text(err_path_);
   return result;
 }
 

@@ -54,6 +54,9 @@ std::string program(const std::string& name);
 /// A new empty directory under the system's temporary directory.
 std::string make_temp_dir();
 
+/// The whole contents of a file ("" when it cannot be read).
+std::string read_text(const std::string& path);
+
 /// Counts the lines of `text` (a last line without a newline counts).
 int count_lines(const std::string& text);
 

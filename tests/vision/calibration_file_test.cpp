@@ -26,13 +26,6 @@ StereoCalibration sample() {
   return c;
 }
 
-std::string text_of(const std::string& path) {
-  std::ifstream file(path);
-  std::stringstream s;
-  s << file.rdbuf();
-  return s.str();
-}
-
 // What is written is read back: every parameter to 1e-12.
 TEST(CalibrationFile, RoundTrip) {
   const std::string path = test::make_temp_dir() + "/stereo.yaml";
@@ -49,14 +42,15 @@ TEST(CalibrationFile, RoundTrip) {
   EXPECT_DOUBLE_EQ(back.rms_left, 0.21);
   EXPECT_EQ(back.source, "test");
   EXPECT_FALSE(back.date.empty());
-  EXPECT_NE(text_of(path).find("P: !!opencv-matrix"), std::string::npos) << "P is written too";
+  EXPECT_NE(test::read_text(path).find("P: !!opencv-matrix"), std::string::npos)
+      << "P is written too";
 }
 
 // A missing or malformed key is named.
 TEST(CalibrationFile, BadKeysAreNamed) {
   const std::string dir = test::make_temp_dir();
   write_calibration(dir + "/good.yaml", sample());
-  const std::string good = text_of(dir + "/good.yaml");
+  const std::string good = test::read_text(dir + "/good.yaml");
 
   std::string no_k = good;
   const size_t right = no_k.find("camera_right");
@@ -85,12 +79,12 @@ TEST(CalibrationFile, FailedWriteKeepsTheOldFile) {
   const std::string dir = test::make_temp_dir();
   const std::string path = dir + "/stereo.yaml";
   write_calibration(path, sample());
-  const std::string before = text_of(path);
+  const std::string before = test::read_text(path);
   std::filesystem::create_directory(path + ".tmp");  // the temporary cannot be created
   StereoCalibration swapped = sample();
   std::swap(swapped.left, swapped.right);
   EXPECT_THROW(write_calibration(path, swapped), CalibrationError);
-  EXPECT_EQ(text_of(path), before);
+  EXPECT_EQ(test::read_text(path), before);
 }
 
 }  // namespace
