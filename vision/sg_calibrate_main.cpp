@@ -27,6 +27,7 @@
 #include "common/shutdown.hpp"
 #include "vision/checkerboard.hpp"
 #include "vision/dlt.hpp"
+#include "vision/image_folder.hpp"
 #include "vision/registration.hpp"
 #include "vision/robot_calibration.hpp"
 #include "vision/triangulation.hpp"
@@ -75,20 +76,6 @@ std::vector<std::vector<double>> read_rows(const std::string& path, size_t colum
   return rows;
 }
 
-std::vector<std::string> images_in(const std::string& dir) {
-  if (!fs::is_directory(dir)) throw std::runtime_error(dir + ": not a folder");
-  std::vector<std::string> files;
-  for (const auto& e : fs::directory_iterator(dir)) {
-    std::string ext = e.path().extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-    if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp")
-      files.push_back(e.path());
-  }
-  std::sort(files.begin(), files.end());
-  if (files.empty()) throw std::runtime_error(dir + ": holds no images");
-  return files;
-}
-
 int run_dlt(const std::string& left_csv, const std::string& right_csv, int width, int height,
             const std::string& out) {
   sg::vision::StereoCalibration c;
@@ -124,7 +111,7 @@ int run_checkerboard(const std::string& left_dir, const std::string& right_dir,
   if (!(in >> w >> x >> h) || x != 'x' || w < 2 || h < 2)
     throw std::runtime_error("--pattern '" + pattern +
                              "': expected inner corners as COLSxROWS, e.g. 9x6");
-  const auto left = images_in(left_dir), right = images_in(right_dir);
+  const auto left = sg::vision::list_images(left_dir), right = sg::vision::list_images(right_dir);
   size_t done = 0;
   const auto result = sg::vision::calibrate_checkerboard(
       left, right, {{w, h}, square}, [&](const std::string& file) {

@@ -24,6 +24,7 @@
 #include "common/shutdown.hpp"
 #include "vision/blob_tracker.hpp"
 #include "vision/calibration_file.hpp"
+#include "vision/image_folder.hpp"
 #include "vision/image_message.hpp"
 #include "vision/stereo_pairer.hpp"
 #include "vision/triangulation.hpp"
@@ -170,8 +171,8 @@ class FrameSource {
     if (o.left.empty() || o.right.empty())
       throw std::runtime_error("--left and --right are required for --source " + o.source);
     if (o.source == "images") {
-      files_[0] = list_images(o.left);
-      files_[1] = list_images(o.right);
+      files_[0] = sg::vision::list_images(o.left);
+      files_[1] = sg::vision::list_images(o.right);
       if (files_[0].size() != files_[1].size())
         throw std::runtime_error("--left has " + std::to_string(files_[0].size()) +
                                  " images but --right has " + std::to_string(files_[1].size()));
@@ -220,19 +221,6 @@ class FrameSource {
   bool live() const { return o_.source == "v4l2"; }
 
  private:
-  static std::vector<std::string> list_images(const std::string& dir) {
-    if (!fs::is_directory(dir)) throw std::runtime_error(dir + ": not a folder of images");
-    std::vector<std::string> files;
-    for (const auto& entry : fs::directory_iterator(dir)) {
-      std::string ext = entry.path().extension().string();
-      std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-      if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".ppm")
-        files.push_back(entry.path());
-    }
-    std::sort(files.begin(), files.end());
-    if (files.empty()) throw std::runtime_error(dir + ": holds no images (png, jpg, bmp, ppm)");
-    return files;
-  }
   static cv::Mat read(const std::string& path) {
     cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);
     if (image.empty()) throw std::runtime_error(path + ": cannot read the image");
