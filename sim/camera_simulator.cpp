@@ -63,9 +63,9 @@ void CameraSimulator::render(int64_t index, const ArmState& arm, StereoFrame& fr
   frame.index = index;
   frame.time = static_cast<double>(index) / params_.frame_rate;
   frame.ball = ball_position(index, arm);
+  DynamicScene scene = dynamic_scene(frame.time, frame.ball, arm, index);  // both cameras see it
   for (size_t i = 0; i < 2; ++i) {
-    DynamicScene scene = dynamic_scene(frame.time, frame.ball, arm, index);
-    scene.noise_frame = index * 2 + static_cast<int64_t>(i);
+    scene.noise_frame = index * 2 + static_cast<int64_t>(i);  // each its own sensor noise
     frame.visibility[i] = renderers_[i]->render(scene, frame.image[i]);
     frame.seen[i] = frame.visibility[i].visible_px >= params_.min_visible_px;
   }
