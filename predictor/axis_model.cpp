@@ -13,7 +13,6 @@ namespace {
 class BurgAxis : public AxisModel {
  public:
   explicit BurgAxis(const BurgParams& p) : p_(p), a_(p.initial_coefficients) {
-    buffer_.reserve(static_cast<size_t>(p.window));
     centred_.reserve(static_cast<size_t>(p.window));
   }
 
@@ -72,7 +71,7 @@ class BurgAxis : public AxisModel {
   std::vector<double> a_;
   std::deque<double> history_;
   double mean_ = 0.0;
-  std::vector<double> buffer_, centred_;
+  std::vector<double> centred_;
 };
 
 class KalmanAxis : public AxisModel {

@@ -28,16 +28,6 @@ ColorDetector::ColorDetector(const ColorThresholds& t)
     throw std::invalid_argument("colour thresholds: a minimum is above its maximum");
 }
 
-void ColorDetector::mask(const cv::Mat& bgr, const cv::Rect& roi, cv::Mat& out) const {
-  CV_Assert(bgr.type() == CV_8UC3);
-  out.create(roi.size(), CV_8U);
-  for (int y = 0; y < roi.height; ++y) {
-    const uint8_t* in = bgr.ptr<uint8_t>(roi.y + y) + 3 * roi.x;
-    uint8_t* o = out.ptr<uint8_t>(y);
-    for (int x = 0; x < roi.width; ++x, in += 3) o[x] = is_object(in) ? 255 : 0;
-  }
-}
-
 ColorThresholds ColorThresholds::learn(const cv::Mat& bgr, const cv::Rect& roi, double margin,
                                        double keep) {
   if (bgr.type() != CV_8UC3) throw std::invalid_argument("learn: the image must be 8-bit BGR");

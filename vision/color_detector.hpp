@@ -40,9 +40,6 @@ class ColorDetector {
            r * kOne <= r_hi_ * sum && g * kOne >= g_lo_ * sum && b * kOne >= b_lo_ * sum;
   }
 
-  /// A binary image (CV_8U, 255 for object) of the pixels of `bgr` inside `roi`.
-  void mask(const cv::Mat& bgr, const cv::Rect& roi, cv::Mat& out) const;
-
   const ColorThresholds& thresholds() const { return t_; }
 
  private:
