@@ -1,0 +1,278 @@
+#include "arm_driver/arm_driver.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cmath>
+
+namespace sg::arm {
+namespace {
+
+using Cmd = stereograsp::arm_cmd_t;
+using Status = stereograsp::arm_status_t;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// Wraps the line and adds up the time spent inside it (waiting for bytes, writing them): the
+/// rest of an interaction is the driver's own overhead.
+class TimedStream final : public ByteStream {
+ public:
+  explicit TimedStream(std::unique_ptr<ByteStream> inner) : inner_(std::move(inner)) {}
+  void write(std::span<const uint8_t> bytes) override {
+    const auto start = Clock::now();
+    inner_->write(bytes);
+    inside_ += seconds_since(start);
+  }
+  std::optional<uint8_t> read_byte(std::chrono::microseconds timeout) override {
+    const auto start = Clock::now();
+    auto byte = inner_->read_byte(timeout);
+    inside_ += seconds_since(start);
+    return byte;
+  }
+  void discard_input() override { inner_->discard_input(); }
+  double inside() const { return inside_; }
+
+ private:
+  std::unique_ptr<ByteStream> inner_;
+  double inside_ = 0;
+};
+
+Joints to_joints(const rapl::JointArray& q) { return Eigen::Map<const Joints>(q.data()); }
+
+rapl::JointArray to_array(const Joints& q) {
+  rapl::JointArray out;
+  for (int i = 0; i < 6; ++i) out[i] = q[i];
+  return out;
+}
+
+}  // namespace
+
+void set_joints(const ArmGeometry& geometry, const Joints& q, Status& status) {
+  for (int i = 0; i < 6; ++i) status.joints[i] = q[i];
+  const Eigen::Isometry3d tool = forward_kinematics(geometry, q);
+  const Eigen::Vector3d rpy = rpy_from_rotation(tool.linear());
+  for (int i = 0; i < 3; ++i) {
+    status.tool_position[i] = tool.translation()[i];
+    status.tool_orientation[i] = rpy[i];
+  }
+}
+
+ArmDriver::ArmDriver(ArmGeometry geometry, DriverSettings settings, DeviceOpener open_device)
+    : validator_(std::move(geometry)),
+      settings_(settings),
+      open_device_(std::move(open_device)) {
+  status_.state = Status::STATE_DISCONNECTED;
+  status_.gripper = Status::GRIPPER_UNKNOWN;
+  status_.last_received_sequence = -1;
+  status_.last_executed_sequence = -1;
+  status_.last_rejected_sequence = -1;
+  status_.speed = 0;
+  set_joints(validator_.geometry(), current_, status_);
+}
+
+template <class F>
+void ArmDriver::update(F&& change) {
+  std::lock_guard lock(mutex_);
+  change(status_);
+  ++version_;
+}
+
+void ArmDriver::submit(const Cmd& command) {
+  std::lock_guard lock(mutex_);
+  const Joints reference =
+      pending_ && pending_->moves_arm() ? pending_->joints : commanded_.value_or(current_);
+  ValidationResult result = validator_.validate(command, reference);
+  status_.last_received_sequence = command.sequence;
+  if (result.target) {
+    if (pending_) spdlog::debug("command {} replaces {}", command.sequence, pending_->sequence);
+    pending_ = std::move(*result.target);
+  } else {
+    status_.last_rejected_sequence = command.sequence;
+    status_.rejection_reason = result.reason;
+    spdlog::warn("rejected command {} from '{}': {}", command.sequence, command.sender,
+                 result.reason);
+  }
+  ++version_;
+  wake_.notify_all();
+}
+
+std::pair<Status, uint64_t> ArmDriver::status() const {
+  std::lock_guard lock(mutex_);
+  return {status_, version_};
+}
+
+double ArmDriver::last_overhead() const {
+  std::lock_guard lock(mutex_);
+  return overhead_;
+}
+
+bool ArmDriver::connect(std::stop_token stop) {
+  double wait = settings_.reconnect_min;
+  while (!stop.stop_requested()) {
+    try {
+      stream_ = std::make_unique<TimedStream>(open_device_());
+      link_ = std::make_unique<C550Link>(*stream_, settings_.slave, settings_.timing);
+      link_->open_session();
+      speed_percent_ = -1;
+      read_joints();
+      update([](Status& s) {
+        s.state = Status::STATE_IDLE;
+        s.error.clear();
+      });
+      spdlog::info("connected: host session open");
+      return true;
+    } catch (const std::exception& e) {
+      link_.reset();
+      stream_.reset();
+      update([&](Status& s) {
+        s.state = Status::STATE_DISCONNECTED;
+        s.error = e.what();
+      });
+      spdlog::warn("cannot connect ({}); again in {:.1f} s", e.what(), wait);
+      std::unique_lock lock(mutex_);
+      wake_.wait_for(lock, stop, std::chrono::duration<double>(wait), [] { return false; });
+      wait = std::min(wait * 2, settings_.reconnect_max);
+    }
+  }
+  return false;
+}
+
+void ArmDriver::disconnect(const std::string& why) {
+  spdlog::error("line lost: {}", why);
+  link_.reset();
+  stream_.reset();
+  update([&](Status& s) {
+    s.state = Status::STATE_DISCONNECTED;
+    s.error = why;
+  });
+}
+
+void ArmDriver::read_joints() {
+  const Joints q = to_joints(link_->read_joints());
+  update([&](Status& s) {
+    current_ = q;
+    set_joints(validator_.geometry(), q, s);
+    const bool moving =
+        commanded_ && (q - *commanded_).cwiseAbs().maxCoeff() > settings_.arrived_tolerance;
+    if (s.state != Status::STATE_ERROR) s.state = moving ? Status::STATE_MOVING : Status::STATE_IDLE;
+    if (!moving) s.source_utime = 0;
+  });
+}
+
+void ArmDriver::act(const ArmTarget& target) {
+  const auto& timing = settings_.timing;
+  if (target.mode == Cmd::MODE_STOP) {
+    link_->command("ABORT", timing.reply_timeout);
+    return;
+  }
+  const int percent = std::clamp(static_cast<int>(std::lround(target.speed * 100)), 1, 100);
+  if (percent != speed_percent_) {
+    link_->command(rapl::speed(percent), timing.reply_timeout);
+    speed_percent_ = percent;
+  }
+  if (target.moves_arm()) {
+    link_->command(rapl::move_joints(to_array(target.joints)), timing.motion_reply);
+  } else if (target.mode == Cmd::MODE_HOME) {
+    link_->command("READY", timing.motion_reply);
+  }
+  if (target.gripper != Cmd::GRIPPER_KEEP) {
+    link_->command(target.gripper == Cmd::GRIPPER_OPEN ? "OPEN" : "CLOSE", timing.motion_reply);
+  }
+}
+
+void ArmDriver::execute(ArmTarget target) {
+  const auto start = Clock::now();
+  const double inside_before = static_cast<TimedStream&>(*stream_).inside();
+  update([&](Status& s) {
+    s.state = Status::STATE_MOVING;
+    s.source_utime = target.source_utime;
+  });
+  try {
+    act(target);
+  } catch (const ControllerError& e) {
+    update([&](Status& s) {
+      s.last_executed_sequence = target.sequence;  // delivered: it ran, and the controller refused
+      s.last_rejected_sequence = target.sequence;
+      s.rejection_reason = std::string("controller: ") + e.what();
+      s.error = s.rejection_reason;
+      s.state = Status::STATE_ERROR;
+    });
+    read_joints();
+    return;
+  } catch (const LinkError& e) {
+    if (!link_->delivered()) {
+      requeue(std::move(target));
+      throw;
+    }
+    spdlog::warn("command {}: {} (it reached the controller; not sent again)", target.sequence,
+                 e.what());
+  } catch (const LinkDown&) {
+    if (!link_->delivered()) requeue(std::move(target));
+    throw;
+  }
+  attempts_ = 0;
+  update([&](Status& s) {
+    s.last_executed_sequence = target.sequence;
+    s.speed = speed_percent_ / 100.0;
+    if (target.mode == Cmd::MODE_STOP) commanded_.reset();
+    if (target.moves_arm()) commanded_ = target.joints;
+    if (target.mode == Cmd::MODE_HOME) commanded_.reset();
+    if (target.gripper == Cmd::GRIPPER_OPEN) s.gripper = Status::GRIPPER_OPEN;
+    if (target.gripper == Cmd::GRIPPER_CLOSE) s.gripper = Status::GRIPPER_CLOSED;
+    if (s.state == Status::STATE_ERROR) s.state = Status::STATE_MOVING;
+    s.error.clear();
+  });
+  read_joints();
+  const double total = seconds_since(start);
+  const double inside = static_cast<TimedStream&>(*stream_).inside() - inside_before;
+  update([&](Status& s) {
+    s.interaction_time = total;
+    overhead_ = total - inside;
+  });
+}
+
+void ArmDriver::requeue(ArmTarget target) {
+  std::lock_guard lock(mutex_);
+  if (pending_) return;  // a newer command is waiting: latest wins
+  if (++attempts_ >= settings_.max_attempts) {
+    status_.last_rejected_sequence = target.sequence;
+    status_.rejection_reason = "not delivered after " + std::to_string(attempts_) + " attempts";
+    ++version_;
+    attempts_ = 0;
+    return;
+  }
+  pending_ = std::move(target);
+}
+
+std::optional<ArmTarget> ArmDriver::wait_for_work(std::stop_token stop) {
+  std::unique_lock lock(mutex_);
+  const bool moving = status_.state == Status::STATE_MOVING;
+  const double poll = moving ? settings_.moving_poll : settings_.idle_poll;
+  wake_.wait_for(lock, stop, std::chrono::duration<double>(poll), [&] { return pending_.has_value(); });
+  std::optional<ArmTarget> target = std::move(pending_);
+  pending_.reset();
+  return target;
+}
+
+void ArmDriver::run(std::stop_token stop) {
+  while (!stop.stop_requested()) {
+    if (!link_ && !connect(stop)) return;
+    try {
+      if (std::optional<ArmTarget> target = wait_for_work(stop)) {
+        execute(std::move(*target));
+      } else if (!stop.stop_requested()) {
+        read_joints();
+      }
+    } catch (const LinkDown& e) {
+      disconnect(e.what());
+    } catch (const LinkError& e) {
+      spdlog::warn("{}", e.what());
+      update([&](Status& s) { s.error = e.what(); });
+    }
+  }
+}
+
+}  // namespace sg::arm

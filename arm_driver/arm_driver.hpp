@@ -1,0 +1,90 @@
+#pragma once
+
+/// The driver core: validated commands go into a latest-wins slot, one interaction with the
+/// controller is in flight at a time, and the status is kept for the bus. The controller answers
+/// one interaction every 0.72-0.84 s, so a command that arrives meanwhile replaces the pending one
+/// (never a backlog), and no command is executed twice: a command counts as executed once its CR
+/// has reached the controller.
+///
+///     ArmDriver driver(geometry, settings, [&] { return SerialPort::open(path, serial); });
+///     std::jthread worker([&](std::stop_token stop) { driver.run(stop); });
+///     driver.submit(command);                       // from the bus thread
+///     auto [status, version] = driver.status();     // publish when version changes
+
+#include <condition_variable>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <stop_token>
+
+#include "arm_driver/byte_stream.hpp"
+#include "arm_driver/c550_link.hpp"
+#include "arm_driver/command_validator.hpp"
+#include "stereograsp/arm_status_t.hpp"
+
+namespace sg::arm {
+
+struct DriverSettings {
+  int slave = 1;
+  LinkTiming timing;
+  double moving_poll = 0.1;        ///< s between W2 reads while the arm moves and nothing waits
+  double idle_poll = 0.5;          ///< s between W2 reads at rest (also notices a lost line)
+  double reconnect_min = 0.2;      ///< s, first wait before reconnecting; doubles ...
+  double reconnect_max = 2.0;      ///< ... up to this
+  double arrived_tolerance = 1e-3; ///< rad: within this of the target, the arm is IDLE
+  int max_attempts = 3;            ///< sends of an undelivered command before it is rejected
+};
+
+using DeviceOpener = std::function<std::unique_ptr<ByteStream>()>;
+
+class ArmDriver {
+ public:
+  ArmDriver(ArmGeometry geometry, DriverSettings settings, DeviceOpener open_device);
+
+  /// Validates a command (bus thread) and puts it in the slot, or records its rejection.
+  void submit(const stereograsp::arm_cmd_t& command);
+
+  /// The status with utime unset, and a version that changes with every change.
+  std::pair<stereograsp::arm_status_t, uint64_t> status() const;
+
+  /// The worker: connects (and reconnects with back-off), runs interactions, polls the joints.
+  void run(std::stop_token stop);
+
+  /// Driver time spent per interaction outside the serial line (validation excluded): for the
+  /// benchmark; seconds, of the last interaction.
+  double last_overhead() const;
+
+ private:
+  bool connect(std::stop_token stop);
+  void disconnect(const std::string& why);
+  void execute(ArmTarget target);
+  void act(const ArmTarget& target);
+  void read_joints();
+  std::optional<ArmTarget> wait_for_work(std::stop_token stop);
+  void requeue(ArmTarget target);
+  template <class F>
+  void update(F&& change);
+
+  CommandValidator validator_;
+  DriverSettings settings_;
+  DeviceOpener open_device_;
+  std::unique_ptr<ByteStream> stream_;
+  std::unique_ptr<C550Link> link_;
+  int speed_percent_ = -1;  ///< the controller's SPEED, -1 before the first
+  int attempts_ = 0;        ///< sends of the pending command that did not reach the controller
+
+  mutable std::mutex mutex_;
+  std::condition_variable_any wake_;
+  std::optional<ArmTarget> pending_;
+  std::optional<Joints> commanded_;  ///< the last joint target sent
+  Joints current_ = Joints::Zero();
+  stereograsp::arm_status_t status_;
+  uint64_t version_ = 0;
+  double overhead_ = 0;
+};
+
+/// Copies joints and the tool pose (forward kinematics) into a status.
+void set_joints(const ArmGeometry& geometry, const Joints& q, stereograsp::arm_status_t& status);
+
+}  // namespace sg::arm
