@@ -9,7 +9,7 @@ namespace sg::arm {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-constexpr double kRadPerDeg = kPi / 180.0;  // configuration and the A465 table only
+constexpr double kRadPerDeg = kPi / 180.0;   // configuration and the A465 table only
 constexpr double kShoulderSingular = 1e-12;  // m: wrist centre this close to the waist axis
 constexpr double kWristSingular = 1e-9;      // |sin q5| below this: wrist straight
 constexpr double kReachSlack = 1e-12;        // relative: roundoff at full stretch
@@ -41,7 +41,7 @@ Joints joints_from_thetas(const ArmGeometry& g, const Joints& theta) {
 
 /// theta_1 candidates for the wrist centre c (base frame): facing it, then reaching backwards.
 std::vector<double> waist_thetas(const ArmGeometry& g, const Eigen::Vector3d& c, double hint) {
-  const double lateral = -std::sin(g.links[1].alpha) * (g.links[1].d + g.links[2].d);
+  const double lateral = -sign(std::sin(g.links[1].alpha)) * (g.links[1].d + g.links[2].d);
   const double rho2 = c.x() * c.x() + c.y() * c.y();
   const double radial2 = rho2 - lateral * lateral;
   const double scale = std::max(rho2, lateral * lateral);
@@ -58,7 +58,8 @@ std::vector<std::array<double, 2>> arm_thetas(const ArmGeometry& g, const Eigen:
   const double s1 = -sign(std::sin(g.links[1].alpha));
   const double s3 = -sign(std::sin(g.links[3].alpha));
   const double a1 = g.links[1].a, a2 = g.links[2].a, a3 = g.links[3].a, d4 = g.links[3].d;
-  // Wrist centre in frame 1's x (radial) and, negated by alpha_1, its height above the shoulder.
+  // The wrist centre in the arm's plane: (px, py) = RotZ(theta_2) (X, Y) below, where px is its
+  // radial distance beyond the shoulder offset a_1 and py = -s1 times its height above frame 1.
   const double px = std::cos(theta1) * c.x() + std::sin(theta1) * c.y() - a1;
   const double py = -s1 * (c.z() - g.links[0].d);
   const double R = std::hypot(a3, d4);
@@ -96,8 +97,7 @@ std::vector<Eigen::Vector3d> wrist_thetas(const ArmGeometry& g, const Eigen::Mat
     const double s5 = sa5 * (std::cos(t4) * v.x() + std::sin(t4) * v.y());
     const double t5 = std::atan2(s5, c5);
     const Eigen::Matrix3d N =
-        (rot_z(t4) * rot_x(g.links[4].alpha) * rot_z(t5) * rot_x(g.links[5].alpha)).transpose() *
-        M;
+        (rot_z(t4) * rot_x(g.links[4].alpha) * rot_z(t5) * rot_x(g.links[5].alpha)).transpose() * M;
     out.emplace_back(t4, t5, std::atan2(N(1, 0), N(0, 0)));
   }
   return out;
@@ -159,14 +159,15 @@ bool Workspace::contains(const Eigen::Vector3d& p) const {
 ArmGeometry ArmGeometry::a465() {
   // {alpha deg, a m, d m, offset deg, limit deg, speed deg/s}; the limits are symmetric.
   constexpr double kTable[6][6] = {
-      {0, 0, 0.330, 0, 175, 180},     {-90, 0, 0, -90, 90, 180},  {0, 0.305, 0, -90, 110, 180},
-      {-90, 0, 0.330, 0, 180, 171},   {90, 0, 0, 0, 105, 173},    {-90, 0, 0.076, 180, 180, 171},
+      {0, 0, 0.330, 0, 175, 180},   {-90, 0, 0, -90, 90, 180}, {0, 0.305, 0, -90, 110, 180},
+      {-90, 0, 0.330, 0, 180, 171}, {90, 0, 0, 0, 105, 173},   {-90, 0, 0.076, 180, 180, 171},
   };
   ArmGeometry g;
   for (int i = 0; i < 6; ++i) {
     const double* r = kTable[i];
-    g.links[i] = {r[0] * kRadPerDeg,  r[1],           r[2], r[3] * kRadPerDeg, -r[4] * kRadPerDeg,
-                  r[4] * kRadPerDeg, r[5] * kRadPerDeg};
+    g.links[i] = {
+        r[0] * kRadPerDeg, r[1], r[2], r[3] * kRadPerDeg, -r[4] * kRadPerDeg, r[4] * kRadPerDeg,
+        r[5] * kRadPerDeg};
   }
   g.tool = Eigen::Translation3d(0, 0, 0.15);
   g.workspace.min = {-0.90, -0.90, 0.05};
@@ -219,7 +220,8 @@ std::string ik_structure_problem(const std::array<DhLink, 6>& l) {
   if (!near_abs_90deg(l[1].alpha)) return "row 2 must have alpha = +-90";
   if (l[2].alpha != 0 || !(l[2].a > 0)) return "row 3 must have alpha = 0 and a > 0";
   for (int i = 3; i < 6; ++i) {
-    if (!near_abs_90deg(l[i].alpha)) return "row " + std::to_string(i + 1) + " must have alpha = +-90";
+    if (!near_abs_90deg(l[i].alpha))
+      return "row " + std::to_string(i + 1) + " must have alpha = +-90";
   }
   if (l[4].a != 0 || l[4].d != 0 || l[5].a != 0) {
     return "rows 5 and 6 must have a = 0 and row 5 d = 0 (a spherical wrist)";
@@ -238,7 +240,8 @@ IkResult solve_nearest(const ArmGeometry& geometry, const Eigen::Isometry3d& tcp
                        const Joints& current) {
   if (!tcp.matrix().allFinite()) return {std::nullopt, "target pose is not finite"};
   if (!current.allFinite()) return {std::nullopt, "current joints are not finite"};
-  if (!geometry.workspace.contains(tcp.translation())) return {std::nullopt, "outside the workspace"};
+  if (!geometry.workspace.contains(tcp.translation()))
+    return {std::nullopt, "outside the workspace"};
   const std::vector<Joints> solutions = solve_all(geometry, tcp, current);
   if (solutions.empty()) return {std::nullopt, "out of reach"};
 
@@ -262,7 +265,8 @@ IkResult solve_nearest(const ArmGeometry& geometry, const Eigen::Isometry3d& tcp
       best = q, best_max = t.maxCoeff(), best_sum = t.sum();
     }
   }
-  if (!best) return {std::nullopt, "outside joint limits (joint " + std::to_string(violated_joint) + ")"};
+  if (!best)
+    return {std::nullopt, "outside joint limits (joint " + std::to_string(violated_joint) + ")"};
   return {best, ""};
 }
 
@@ -276,7 +280,7 @@ double motion_time(const ArmGeometry& geometry, const Joints& from, const Joints
 
 namespace {
 
-/// A list of `n` rows of `width` finite numbers at `key`, or `fallback` when absent.
+/// The list of `n` rows of `width` finite numbers at `key` (which must be present).
 std::vector<std::vector<double>> read_rows(const sg::Config& config, const std::string& key,
                                            std::size_t n, std::size_t width,
                                            const std::string& shape) {
@@ -299,12 +303,12 @@ std::vector<std::vector<double>> read_rows(const sg::Config& config, const std::
   return rows;
 }
 
-/// A list of `n` finite numbers at `key`.
+/// The list of `n` finite numbers at `key` (which must be present).
 std::vector<double> read_list(const sg::Config& config, const std::string& key, std::size_t n) {
   const auto values = config.require<std::vector<double>>(key);
   if (values.size() != n) {
-    throw config.error_at(key, "expected " + std::to_string(n) + " numbers, got " +
-                                   std::to_string(values.size()));
+    throw config.error_at(
+        key, "expected " + std::to_string(n) + " numbers, got " + std::to_string(values.size()));
   }
   for (const double v : values) {
     if (!std::isfinite(v)) throw config.error_at(key, "holds a non-finite number");
@@ -357,8 +361,9 @@ ArmGeometry load_arm_geometry(const sg::Config& config) {
   g.workspace.min = read_vector3(config, "arm.workspace_min", g.workspace.min);
   g.workspace.max = read_vector3(config, "arm.workspace_max", g.workspace.max);
   if (!(g.workspace.min.array() < g.workspace.max.array()).all()) {
-    throw config.error_at(config.has("arm.workspace_max") ? "arm.workspace_max" : "arm.workspace_min",
-                          "workspace_min must be below workspace_max on every axis");
+    throw config.error_at(
+        config.has("arm.workspace_max") ? "arm.workspace_max" : "arm.workspace_min",
+        "workspace_min must be below workspace_max on every axis");
   }
   return g;
 }

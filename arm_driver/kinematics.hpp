@@ -13,7 +13,8 @@
 ///
 /// so the flange (frame 6) is T_06 = T_01 T_12 ... T_56 and the tool centre point (TCP) is
 /// T_06 * tool. With the A465 table, q = 0 is the arm standing straight up (the "candle"):
-/// flange at z = 0.330 + 0.305 + 0.330 + 0.076 m, flange z axis up, flange x axis along -X.
+/// flange at z = 0.330 + 0.305 + 0.330 + 0.076 m with the base's orientation (the 180 deg
+/// offset of joint 6 makes R_06(0) = I), so the default TCP is at (0, 0, 1.191) m.
 ///
 ///     const sg::arm::ArmGeometry arm = sg::arm::ArmGeometry::a465();
 ///     const Eigen::Isometry3d grasp =
@@ -66,7 +67,7 @@ struct ArmGeometry {
   /// The CRS A465 (crs-arm.md): lengths 330, 305, 330, 76 mm; limits +-175, +-90, +-110, +-180,
   /// +-105, +-180 deg; speeds 180, 180, 180, 171, 173, 171 deg/s. Tool: the gripper's TCP
   /// 0.15 m along the flange z axis. Workspace: x, y in [-0.90, 0.90] m, just beyond the TCP's
-  /// reach (0.861 m from the shoulder axis), and z in [0.05, 1.25] m: a guard that keeps the TCP
+  /// reach (0.861 m from the waist axis), and z in [0.05, 1.25] m: a guard that keeps the TCP
   /// (and the finger tips a few cm beyond it) off the mounting table at z = 0 and that contains
   /// the zero pose (TCP at z = 1.191 m). A lab narrows it to its own table in configuration.
   static ArmGeometry a465();
@@ -99,8 +100,9 @@ Eigen::Isometry3d forward_kinematics(const ArmGeometry& geometry, const Joints& 
 ///    coordinates of c in the XY plane: theta_1 = phi - atan2(D, +-sqrt(rho^2 - D^2))
 ///    (facing the target first, then reaching over backwards);
 ///  - elbow: in the arm's plane the shoulder-to-wrist distance fixes
-///    a_3 cos(theta_3) - s d_4 sin(theta_3) = K, s = -sin(alpha_3), which has two roots
-///    (q3 >= 0 first: elbow up when the waist faces the target); then theta_2 follows by atan2;
+///    a_3 cos(theta_3) - s d_4 sin(theta_3) = R cos(theta_3 + psi) = K, s = -sin(alpha_3),
+///    R = hypot(a_3, d_4), psi = atan2(s d_4, a_3): two roots, theta_3 + psi >= 0 first (on the
+///    A465 that is q3 >= 0, elbow up when the waist faces the target); theta_2 follows by atan2;
 ///  - wrist: M = (R_03 RotX(alpha_3))^T R_06 = RotZ(theta_4) RotX(alpha_4) RotZ(theta_5)
 ///    RotX(alpha_5) RotZ(theta_6); its third column gives theta_5 and theta_4 (two solutions,
 ///    sin(theta_5) >= 0 first, and the flip theta_4 + pi, -theta_5), the rest gives theta_6.
