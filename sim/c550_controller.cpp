@@ -64,13 +64,13 @@ C550Controller::C550Controller(arm::ArmGeometry geometry, C550Params params)
       rng_(params_.seed) {
   check_params(params_, geometry_);
   motion_ = {params_.ready, params_.ready, kNever, kNever};
-  stroke_ = {params_.gripper_open_width, params_.gripper_open_width, kNever};
+  stroke_ = {params_.gripper_open_width, params_.gripper_open_width, kNever, kNever};
   last_command_time_ = kNever;
 }
 
 void C550Controller::advance(double t) {
   if (t >= motion_.end) motion_ = {motion_.to, motion_.to, motion_.end, motion_.end};
-  if (t >= stroke_end()) stroke_ = {stroke_.to, stroke_.to, stroke_.start};
+  if (t >= stroke_.end) stroke_ = {stroke_.to, stroke_.to, stroke_.end, stroke_.end};
 }
 
 arm::Joints C550Controller::joints(double t) const {
@@ -85,21 +85,13 @@ Eigen::Isometry3d C550Controller::tool_pose(double t) const {
 }
 
 double C550Controller::gripper_opening(double t) const {
-  const double end = stroke_end();
-  if (t >= end) return stroke_.to;
-  const double rate = (params_.gripper_open_width - params_.gripper_closed_width) /
-                      params_.gripper_time;
-  const double step = (t - stroke_.start) * rate;
-  return stroke_.to > stroke_.from ? stroke_.from + step : stroke_.from - step;
+  if (t >= stroke_.end) return stroke_.to;
+  if (t <= stroke_.start) return stroke_.from;
+  const double s = (t - stroke_.start) / (stroke_.end - stroke_.start);
+  return stroke_.from + s * (stroke_.to - stroke_.from);
 }
 
-double C550Controller::stroke_end() const {
-  if (stroke_.from == stroke_.to || params_.gripper_time == 0) return stroke_.start;
-  const double stroke = params_.gripper_open_width - params_.gripper_closed_width;
-  return stroke_.start + std::abs(stroke_.to - stroke_.from) / stroke * params_.gripper_time;
-}
-
-double C550Controller::settle_time() const { return std::max(motion_.end, stroke_end()); }
+double C550Controller::settle_time() const { return std::max(motion_.end, stroke_.end); }
 
 CommandResult C550Controller::set_speed(int percent) {
   if (percent < 1 || percent > 100) {
@@ -176,7 +168,9 @@ void C550Controller::start_motion(const arm::Joints& target, double t) {
 }
 
 void C550Controller::start_stroke(double width, double t) {
-  stroke_ = {gripper_opening(t), width, t};
+  const double from = gripper_opening(t);
+  const double full = params_.gripper_open_width - params_.gripper_closed_width;
+  stroke_ = {from, width, t, t + std::abs(width - from) / full * params_.gripper_time};
 }
 
 std::string C550Controller::memory_access_error(uint8_t memtype, uint16_t segment,

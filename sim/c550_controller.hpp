@@ -140,17 +140,17 @@ class C550Controller {
     double start = 0;
     double end = 0;
   };
-  /// The fingers moving at constant rate from `from` at `start` toward `to`.
+  /// The fingers moving at constant rate from `from` at `start` to `to` at `end`.
   struct Stroke {
     double from = 0;
     double to = 0;
     double start = 0;
+    double end = 0;
   };
 
   void check_time(double t, const char* command);
   void start_motion(const arm::Joints& target, double t);
   void start_stroke(double width, double t);
-  double stroke_end() const;
   std::array<uint8_t, 4 * kPointerCount> pointer_list() const;
 
   arm::ArmGeometry geometry_;
