@@ -137,9 +137,9 @@ void C550Controller::close(double t, const std::optional<Eigen::Vector3d>& ball_
   const bool near = ball_centre && ball_centre->allFinite() &&
                     (tool_pose(t).translation() - *ball_centre).norm() <= params_.grasp_tolerance;
   if (!holding_ && near && gripper_opening(t) > ball_width) holding_ = true;
-  start_stroke(holding_ ? std::max(ball_width, params_.gripper_closed_width)
-                        : params_.gripper_closed_width,
-               t);
+  start_stroke(
+      holding_ ? std::max(ball_width, params_.gripper_closed_width) : params_.gripper_closed_width,
+      t);
 }
 
 double C550Controller::interaction_delay() {
@@ -152,9 +152,9 @@ double C550Controller::interaction_delay() {
 
 void C550Controller::check_time(double t, const char* command) {
   if (!std::isfinite(t) || t < last_command_time_) {
-    throw std::invalid_argument(std::string("C550Controller::") + command + ": time " +
-                                format("%.6f s is before the last command (%.6f s) or not finite",
-                                       t, last_command_time_));
+    throw std::invalid_argument(
+        std::string("C550Controller::") + command + ": time " +
+        format("%.6f s is before the last command (%.6f s) or not finite", t, last_command_time_));
   }
   last_command_time_ = t;
   advance(t);
@@ -162,8 +162,7 @@ void C550Controller::check_time(double t, const char* command) {
 
 void C550Controller::start_motion(const arm::Joints& target, double t) {
   const arm::Joints here = joints(t);
-  const double duration =
-      arm::motion_time(geometry_, here, target, speed_percent_ / 100.0);
+  const double duration = arm::motion_time(geometry_, here, target, speed_percent_ / 100.0);
   motion_ = {here, target, t, t + duration};
 }
 
@@ -173,8 +172,8 @@ void C550Controller::start_stroke(double width, double t) {
   stroke_ = {from, width, t, t + std::abs(width - from) / full * params_.gripper_time};
 }
 
-std::string C550Controller::memory_access_error(uint8_t memtype, uint16_t segment,
-                                                uint16_t offset, int length, bool write) const {
+std::string C550Controller::memory_access_error(uint8_t memtype, uint16_t segment, uint16_t offset,
+                                                int length, bool write) const {
   const std::string where = "memory type " + arm::aci::byte_name(memtype) + " at " +
                             std::to_string(segment) + ":" + std::to_string(offset) + ", " +
                             std::to_string(length) + " bytes: ";
@@ -198,8 +197,8 @@ std::string C550Controller::memory_access_error(uint8_t memtype, uint16_t segmen
   }
 }
 
-std::vector<uint8_t> C550Controller::read_memory(uint8_t memtype, uint16_t segment,
-                                                 uint16_t offset, int length) const {
+std::vector<uint8_t> C550Controller::read_memory(uint8_t memtype, uint16_t segment, uint16_t offset,
+                                                 int length) const {
   if (std::string error = memory_access_error(memtype, segment, offset, length, false);
       !error.empty()) {
     throw std::invalid_argument("read " + error);

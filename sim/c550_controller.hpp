@@ -40,10 +40,10 @@ namespace sg::sim {
 
 /// The model's settings. Times in seconds, lengths in metres, angles in radians.
 struct C550Params {
-  double delay_min = 0.72;  ///< shortest interaction delay (the paper: 0.72 to 0.84 s)
-  double delay_max = 0.84;  ///< longest interaction delay
-  uint32_t seed = 1;        ///< seeds the delay draws
-  int speed_percent = 50;   ///< initial SPEED, percent of the joints' maximum speeds
+  double delay_min = 0.72;            ///< shortest interaction delay (the paper: 0.72 to 0.84 s)
+  double delay_max = 0.84;            ///< longest interaction delay
+  uint32_t seed = 1;                  ///< seeds the delay draws
+  int speed_percent = 50;             ///< initial SPEED, percent of the joints' maximum speeds
   double gripper_time = 0.4;          ///< full stroke, open <-> closed
   double gripper_open_width = 0.08;   ///< between the fingers when open
   double gripper_closed_width = 0.0;  ///< between the fingers when closed on nothing

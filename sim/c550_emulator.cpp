@@ -16,6 +16,9 @@ namespace rapl = arm::rapl;
 
 /// Retries of one block before a host read is abandoned (docs/arm.md: 3 tries).
 constexpr int kBlockTries = 3;
+/// A silence longer than this inside a header or block abandons it (an inter-character time-out:
+/// at 38,400 baud a frame's bytes are 0.26 ms apart, and the host waits 200 ms for an answer).
+constexpr double kFrameGap = 0.1;
 
 std::string trim(std::string_view text) {
   const size_t begin = text.find_first_not_of(" \t");
@@ -43,6 +46,11 @@ int integer(double value, const char* what) {
 
 void no_arguments(const std::string& rest) {
   if (!rest.empty()) throw rapl::RaplError("takes no arguments, got '" + rest + "'");
+}
+
+/// OPEN and CLOSE take an optional force (RobWork sends one); the model ignores it.
+void grip_argument(const std::string& rest) {
+  if (!rest.empty()) numbers(rest, 1, "grip force, ignored");
 }
 
 bool valid_name(const std::string& name) {
@@ -117,6 +125,14 @@ void C550Emulator::event(std::string text) { events_.push_back(std::move(text));
 // ---- ACI ----
 
 void C550Emulator::aci_byte(uint8_t byte, double t) {
+  const bool in_frame = aci_ == Aci::kHeader || (aci_ == Aci::kReceiving && !frame_.empty());
+  if (in_frame && t - last_aci_byte_ > kFrameGap) {
+    event("ACI: " + std::to_string(frame_.size()) + " bytes of a " +
+          (aci_ == Aci::kHeader ? "header" : "block") + " abandoned after a silence");
+    if (aci_ == Aci::kHeader) to_idle();
+    frame_.clear();
+  }
+  last_aci_byte_ = t;
   switch (aci_) {
     case Aci::kHeader:
       header_byte(byte, t);
@@ -143,23 +159,22 @@ void C550Emulator::aci_byte(uint8_t byte, double t) {
   }
 }
 
-bool C550Emulator::aci_restart(uint8_t byte, double t) {
+void C550Emulator::aci_restart(uint8_t byte, double t) {
   if (byte == aci::SOH) {
     to_idle();
     frame_ = {aci::SOH};
     aci_ = Aci::kHeader;
-    return true;
+    return;
   }
   recent_.push_back(byte);
   if (recent_.size() > 3) recent_.erase(recent_.begin());
   const auto enquiry = aci::encode_enquiry(slave_);
-  if (!std::equal(recent_.begin(), recent_.end(), enquiry.begin(), enquiry.end())) return false;
+  if (!std::equal(recent_.begin(), recent_.end(), enquiry.begin(), enquiry.end())) return;
   if (aci_ != Aci::kIdle) event("enquiry in the middle of a transfer: transfer abandoned");
   to_idle();
   const auto reply = aci::encode_enquiry_reply(slave_);
   emit({reply[0], reply[1]}, t);
   emit({reply[2]}, t, true);
-  return true;
 }
 
 void C550Emulator::header_byte(uint8_t byte, double t) {
@@ -339,62 +354,82 @@ void C550Emulator::end_line(double t) {
 }
 
 C550Emulator::Answer C550Emulator::execute(const std::string& line, double t) {
+  using Handler = Answer (C550Emulator::*)(const std::string& rest, double t);
+  static const std::map<std::string, Handler> kCommands = {
+      {"SPEED", &C550Emulator::speed},      {"MA", &C550Emulator::move_absolute},
+      {"W2", &C550Emulator::where},         {"POINT", &C550Emulator::point},
+      {"MOVE", &C550Emulator::move},        {"LLOC", &C550Emulator::lloc},
+      {"JOINT", &C550Emulator::joint},      {"OPEN", &C550Emulator::open},
+      {"CLOSE", &C550Emulator::close},      {"READY", &C550Emulator::ready},
+      {"ABORT", &C550Emulator::abort},      {"FINISH", &C550Emulator::finish},
+      {"NOH", &C550Emulator::no_operation}, {"HELP", &C550Emulator::help}};
   const rapl::CommandLine command = rapl::split_command(line);
-  const std::string& verb = command.verb;
-  const std::string rest = trim(command.rest);
   help_given_ = false;
+  const auto found = kCommands.find(command.verb);
+  if (found == kCommands.end()) return {{"*** 10 UNKNOWN COMMAND '" + command.verb + "'"}, {}};
   try {
-    if (verb == "SPEED") {
-      const int percent = integer(numbers(rest, 1, "percent").front(), "SPEED");
-      const CommandResult result = controller_.set_speed(percent);
-      return {result ? std::vector<std::string>{} : std::vector{result.error}, {}};
-    }
-    if (verb == "MA") {
-      const std::vector<double> degrees = numbers(rest, 6, "joints, degrees");
-      arm::Joints q;
-      for (int i = 0; i < 6; ++i) q[i] = arm::from_degrees(degrees[static_cast<size_t>(i)]);
-      return motion(controller_.move_joints(q, t), t);
-    }
-    if (verb == "W2") {
-      no_arguments(rest);
-      const arm::Joints q = controller_.joints(t);
-      return {{rapl::format_joints_reply({q[0], q[1], q[2], q[3], q[4], q[5]})}, {}};
-    }
-    if (verb == "POINT") return point(rest);
-    if (verb == "MOVE") return move(rest, t);
-    if (verb == "LLOC") return lloc(rest);
-    if (verb == "JOINT") return joint(rest, t);
-    if (verb == "OPEN" || verb == "CLOSE") {
-      if (!rapl::parse_numbers(rest).empty()) numbers(rest, 1, "grip force, ignored");
-      if (verb == "OPEN") {
-        controller_.open(t);
-      } else {
-        controller_.close(t, ball_);
-      }
-      return motion({}, t);
-    }
-    if (verb == "READY") {
-      no_arguments(rest);
-      return motion(controller_.ready(t), t);
-    }
-    if (verb == "ABORT") {
-      no_arguments(rest);
-      controller_.abort(t);
-      return {};
-    }
-    if (verb == "FINISH") {
-      no_arguments(rest);
-      return {{}, controller_.settle_time()};
-    }
-    if (verb == "NOH" || verb == "HELP") {
-      no_arguments(rest);
-      help_given_ = verb == "HELP";
-      return {};
-    }
-    return {{"*** 10 UNKNOWN COMMAND '" + verb + "'"}, {}};
+    return (this->*found->second)(trim(command.rest), t);
   } catch (const rapl::RaplError& e) {
-    return {{"*** 10 " + verb + ": " + e.what()}, {}};
+    return {{"*** 10 " + command.verb + ": " + e.what()}, {}};
   }
+}
+
+C550Emulator::Answer C550Emulator::speed(const std::string& rest, double /*t*/) {
+  const CommandResult result =
+      controller_.set_speed(integer(numbers(rest, 1, "percent").front(), "SPEED"));
+  return {result ? std::vector<std::string>{} : std::vector{result.error}, {}};
+}
+
+C550Emulator::Answer C550Emulator::move_absolute(const std::string& rest, double t) {
+  const std::vector<double> degrees = numbers(rest, 6, "joints, degrees");
+  arm::Joints q;
+  for (int i = 0; i < 6; ++i) q[i] = arm::from_degrees(degrees[static_cast<size_t>(i)]);
+  return motion(controller_.move_joints(q, t), t);
+}
+
+C550Emulator::Answer C550Emulator::where(const std::string& rest, double t) {
+  no_arguments(rest);
+  const arm::Joints q = controller_.joints(t);
+  return {{rapl::format_joints_reply({q[0], q[1], q[2], q[3], q[4], q[5]})}, {}};
+}
+
+C550Emulator::Answer C550Emulator::open(const std::string& rest, double t) {
+  grip_argument(rest);
+  controller_.open(t);
+  return motion({}, t);
+}
+
+C550Emulator::Answer C550Emulator::close(const std::string& rest, double t) {
+  grip_argument(rest);
+  controller_.close(t, ball_);
+  return motion({}, t);
+}
+
+C550Emulator::Answer C550Emulator::ready(const std::string& rest, double t) {
+  no_arguments(rest);
+  return motion(controller_.ready(t), t);
+}
+
+C550Emulator::Answer C550Emulator::abort(const std::string& rest, double t) {
+  no_arguments(rest);
+  controller_.abort(t);
+  return {};
+}
+
+C550Emulator::Answer C550Emulator::finish(const std::string& rest, double /*t*/) {
+  no_arguments(rest);
+  return {{}, controller_.settle_time()};
+}
+
+C550Emulator::Answer C550Emulator::no_operation(const std::string& rest, double /*t*/) {
+  no_arguments(rest);
+  return {};
+}
+
+C550Emulator::Answer C550Emulator::help(const std::string& rest, double /*t*/) {
+  no_arguments(rest);
+  help_given_ = true;
+  return {};
 }
 
 C550Emulator::Answer C550Emulator::motion(const CommandResult& result, double t) {
@@ -402,11 +437,12 @@ C550Emulator::Answer C550Emulator::motion(const CommandResult& result, double t)
   return {{}, t + controller_.interaction_delay()};
 }
 
-C550Emulator::Answer C550Emulator::point(const std::string& rest) {
+C550Emulator::Answer C550Emulator::point(const std::string& rest, double /*t*/) {
   const size_t end = rest.find_first_of(" ,\t");
   const std::string name = rest.substr(0, end);
   if (!valid_name(name)) {
-    throw rapl::RaplError("'" + name + "' is not a location name (a letter, then letters, digits, _)");
+    throw rapl::RaplError("'" + name +
+                          "' is not a location name (a letter, then letters, digits, _)");
   }
   const std::vector<double> values =
       numbers(end == std::string::npos ? "" : rest.substr(end), 6, "x,y,z inches, r,p,y degrees");
@@ -422,20 +458,23 @@ C550Emulator::Answer C550Emulator::point(const std::string& rest) {
 
 C550Emulator::Answer C550Emulator::move(const std::string& rest, double t) {
   const auto found = locations_.find(rest);
-  if (found == locations_.end()) return {{"*** 10 MOVE: location '" + rest + "' is not defined"}, {}};
+  if (found == locations_.end())
+    return {{"*** 10 MOVE: location '" + rest + "' is not defined"}, {}};
   return motion(controller_.move_pose(found->second.xyz, found->second.rpy, t), t);
 }
 
-C550Emulator::Answer C550Emulator::lloc(const std::string& rest) const {
+C550Emulator::Answer C550Emulator::lloc(const std::string& rest, double /*t*/) {
   const auto found = locations_.find(rest);
-  if (found == locations_.end()) return {{"*** 10 LLOC: location '" + rest + "' is not defined"}, {}};
+  if (found == locations_.end())
+    return {{"*** 10 LLOC: location '" + rest + "' is not defined"}, {}};
   return {{rapl::format_location_reply(found->second)}, {}};
 }
 
 C550Emulator::Answer C550Emulator::joint(const std::string& rest, double t) {
   const std::vector<double> values = numbers(rest, 2, "joint 1..6, degrees");
   const int index = integer(values[0], "the joint number");
-  if (index < 1 || index > 6) throw rapl::RaplError("joint " + std::to_string(index) + " is outside 1..6");
+  if (index < 1 || index > 6)
+    throw rapl::RaplError("joint " + std::to_string(index) + " is outside 1..6");
   arm::Joints q = controller_.joints(t);
   q[index - 1] += arm::from_degrees(values[1]);
   return motion(controller_.move_joints(q, t), t);

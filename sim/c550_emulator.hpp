@@ -21,8 +21,10 @@
 ///    emulator sends EOT and waits for the host's EOT echo. On a host write good blocks are
 ///    ACKed and bad ones (framing, LRC, wrong size or end byte) NAKed; the data is written when
 ///    the host's EOT arrives; an EOT before the last block abandons the write. Blocks carry no
-///    sequence number: a block the host resends because our ACK was lost is taken as the next.
-///    SOH or an enquiry between blocks restarts (the host retrying from the top).
+///    sequence number: a block the host resends because our ACK was lost is taken as the next
+///    one (the last block resent is ACKed again and written once). SOH or an enquiry between
+///    blocks restarts (the host retrying from the top). A silence of more than 100 ms inside a
+///    header or block abandons the partial frame (an inter-character time-out).
 ///  - Session: the 1-byte memtype 0x48 read enters RAPL mode when the host echoes the EOT; a
 ///    ^C (0x03) instead of the echo also enters it (and gets its prompt). Any other byte there
 ///    is handled as in ACI mode (e.g. the host retrying the enquiry because our EOT was lost).
@@ -80,7 +82,10 @@ class C550Emulator {
 
   /// True in RAPL mode (after the session byte, until HELP and ^Z ^Z).
   bool in_session() const { return mode_ == Mode::kRapl; }
-  /// Every RAPL command line executed, in order (as received, without the CR).
+  /// Every RAPL command line received whole (up to its CR, which is not included), in order,
+  /// whether it succeeded or answered `***`; empty lines and lines cancelled by ^C are not
+  /// included, an over-long line is cut at kMaxLine and marked "...". Tests use it to check
+  /// that no command ran twice.
   std::vector<std::string> executed_commands() const { return executed_; }
   /// Protocol events since the last call (NAKs and why, abandoned transfers, refused commands),
   /// one line each, for the shell's log.
@@ -113,7 +118,8 @@ class C550Emulator {
 
   // ACI
   void aci_byte(uint8_t byte, double t);
-  bool aci_restart(uint8_t byte, double t);
+  /// Idle handling: SOH starts a header, an enquiry for this slave is answered.
+  void aci_restart(uint8_t byte, double t);
   void header_byte(uint8_t byte, double t);
   void accept_header(const arm::aci::AciHeader& header, double t);
   void send_block(double t);
@@ -126,11 +132,23 @@ class C550Emulator {
   void rapl_byte(uint8_t byte, double t);
   void end_line(double t);
   Answer execute(const std::string& line, double t);
+  /// A motion command's answer: its error at once, or nothing after interaction_delay().
   Answer motion(const CommandResult& result, double t);
-  Answer point(const std::string& rest);
+  // One per command: `rest` is the text after the verb, trimmed. Bad arguments throw RaplError.
+  Answer speed(const std::string& rest, double t);
+  Answer move_absolute(const std::string& rest, double t);  ///< MA
+  Answer where(const std::string& rest, double t);          ///< W2
+  Answer point(const std::string& rest, double t);
   Answer move(const std::string& rest, double t);
-  Answer lloc(const std::string& rest) const;
+  Answer lloc(const std::string& rest, double t);
   Answer joint(const std::string& rest, double t);
+  Answer open(const std::string& rest, double t);
+  Answer close(const std::string& rest, double t);
+  Answer ready(const std::string& rest, double t);
+  Answer abort(const std::string& rest, double t);
+  Answer finish(const std::string& rest, double t);
+  Answer no_operation(const std::string& rest, double t);  ///< NOH
+  Answer help(const std::string& rest, double t);
 
   C550Controller& controller_;
   int slave_;
@@ -149,6 +167,7 @@ class C550Emulator {
   std::vector<std::vector<uint8_t>> blocks_;  ///< a host read's frames, or a host write's data
   int block_ = 0;                             ///< the block being sent or received
   int tries_ = 0;                             ///< sends of the current block
+  double last_aci_byte_ = 0;                  ///< when the last ACI byte arrived
 
   // RAPL state
   std::string line_;

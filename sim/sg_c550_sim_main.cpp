@@ -220,7 +220,8 @@ class Simulator {
       schedule_line(t);
       if (t >= next_state) {
         bus_.publish("SIM_ARM_STATE", arm_state(controller_, t));
-        next_state = std::max(next_state + 1.0 / o_.state_rate, t);
+        next_state += 1.0 / o_.state_rate;
+        if (next_state < t) next_state = t + 1.0 / o_.state_rate;  // fell behind: skip ahead
       }
       wait(std::min(next_state, next_event()) - now());
       serve(now());
@@ -249,8 +250,7 @@ class Simulator {
   /// Drops the line once at --disconnect-after and brings a new one --reconnect-after later.
   void schedule_line(double t) {
     if (pty_ && !disconnected_ && o_.disconnect_after > 0 && t >= o_.disconnect_after) {
-      spdlog::info("disconnecting {} (--disconnect-after {} s)", pty_->path(),
-                   o_.disconnect_after);
+      spdlog::info("disconnecting {} (--disconnect-after {} s)", pty_->path(), o_.disconnect_after);
       disconnected_ = true;
       link_.remove();
       emulator_.reset();
@@ -264,7 +264,8 @@ class Simulator {
   double next_event() const {
     double next = std::numeric_limits<double>::infinity();
     if (emulator_) next = emulator_->next_output_time();
-    if (pty_ && !disconnected_ && o_.disconnect_after > 0) next = std::min(next, o_.disconnect_after);
+    if (pty_ && !disconnected_ && o_.disconnect_after > 0)
+      next = std::min(next, o_.disconnect_after);
     if (!pty_) next = std::min(next, reconnect_at_);
     return next;
   }
@@ -272,7 +273,8 @@ class Simulator {
   void wait(double seconds) {
     const int timeout_ms = static_cast<int>(std::clamp(std::ceil(seconds * 1000), 0.0, 5.0));
     pollfd fds[2] = {{bus_.lcm().getFileno(), POLLIN, 0}, {-1, 0, 0}};
-    if (pty_) fds[1] = {pty_->master(), static_cast<short>(POLLIN | (tx_.empty() ? 0 : POLLOUT)), 0};
+    if (pty_)
+      fds[1] = {pty_->master(), static_cast<short>(POLLIN | (tx_.empty() ? 0 : POLLOUT)), 0};
     if (::poll(fds, pty_ ? 2 : 1, timeout_ms) < 0 && errno != EINTR) {
       throw std::runtime_error(system_error("poll"));
     }

@@ -149,7 +149,7 @@ TEST(C550Controller, CloseNearTheBallHoldsIt) {
   const Eigen::Vector3d ball = c550.tool_pose(0).translation() + Eigen::Vector3d(0.015, 0, 0);
   c550.close(1.0, ball);
   EXPECT_TRUE(c550.holding());
-  EXPECT_NEAR(c550.gripper_opening(1.0 + 0.4), 0.07, 1e-12);  // 2 * ball radius
+  EXPECT_NEAR(c550.gripper_opening(1.0 + 0.4), 0.07, 1e-12);     // 2 * ball radius
   EXPECT_NEAR(c550.gripper_opening(1.0 + 0.025), 0.075, 1e-12);  // 0.08 m in 0.4 s
 }
 

@@ -165,6 +165,33 @@ TEST_F(C550EmulatorTest, BadBlockOnWriteIsNakedThenAccepted) {
   EXPECT_EQ(controller.read_memory(aci::kMemSegment, 0, 0, 3), data);
 }
 
+// The last block sent again (the host lost our ACK) is ACKed again and written once.
+TEST_F(C550EmulatorTest, LastBlockResentAfterALostAckIsAckedAgain) {
+  const Bytes data{9, 8, 7};
+  EXPECT_EQ(start_transfer({.slave = 1, .write = true, .offset = 10, .length = 3}), Bytes{});
+  const Bytes frame = aci::encode_blocks(data).front();
+  EXPECT_EQ(send(frame), Bytes{aci::ACK});
+  EXPECT_EQ(send(frame), Bytes{aci::ACK});
+  EXPECT_EQ(send(aci::EOT), Bytes{});
+  EXPECT_EQ(controller.read_memory(aci::kMemSegment, 0, 10, 4), (Bytes{9, 8, 7, 0}));
+}
+
+// A host that lost our EOT and enquires again is answered; the session is not yet open.
+TEST_F(C550EmulatorTest, EnquiryInsteadOfTheEotEchoIsAnswered) {
+  start_transfer({.slave = 1, .memtype = aci::kMemSession, .length = 1});
+  EXPECT_EQ(send(aci::ACK), Bytes{aci::EOT});
+  EXPECT_EQ(send(bytes(aci::encode_enquiry(1))), bytes(aci::encode_enquiry_reply(1)));
+  EXPECT_FALSE(c550.in_session());
+}
+
+// A header cut short is abandoned after a silence, so a later enquiry is answered.
+TEST_F(C550EmulatorTest, PartialHeaderIsAbandonedAfterASilence) {
+  const auto header = aci::encode_header({.slave = 1, .length = 1});
+  EXPECT_EQ(send(Bytes(header.begin(), header.begin() + 5)), Bytes{});
+  t += 0.5;
+  EXPECT_EQ(send(bytes(aci::encode_enquiry(1))), bytes(aci::encode_enquiry_reply(1)));
+}
+
 // The one-byte 0x48 read answers 0x01 and, once the host echoes EOT, switches to RAPL.
 TEST_F(C550EmulatorTest, SessionReadSwitchesToRapl) {
   const Bytes block = start_transfer({.slave = 1, .memtype = aci::kMemSession, .length = 1});
@@ -287,8 +314,7 @@ TEST_F(C550EmulatorTest, ExecutedCommandsAreRecordedInOrder) {
   command("SPEED 30");
   command("READY", 1.0);
   command("W2");
-  EXPECT_EQ(c550.executed_commands(),
-            (std::vector<std::string>{"NOH", "SPEED 30", "READY", "W2"}));
+  EXPECT_EQ(c550.executed_commands(), (std::vector<std::string>{"NOH", "SPEED 30", "READY", "W2"}));
   EXPECT_EQ(controller.speed_percent(), 30);
 }
 
