@@ -6,7 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <stdexcept>
@@ -57,20 +59,26 @@ constexpr const char* kDefaultsYaml = R"(arm:
   workspace_max: [0.90, 0.90, 1.25]
 )";
 
-void expect_same_geometry(const ArmGeometry& a, const ArmGeometry& b) {
+/// Equal link by link (within 4 ulps, as EXPECT_DOUBLE_EQ), with the same tool and workspace.
+::testing::AssertionResult same_geometry(const ArmGeometry& a, const ArmGeometry& b) {
+  auto near = [](double x, double y) {
+    return std::abs(x - y) <=
+           4 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(x));
+  };
   for (int i = 0; i < 6; ++i) {
-    SCOPED_TRACE("joint " + std::to_string(i + 1));
-    EXPECT_DOUBLE_EQ(a.links[i].alpha, b.links[i].alpha);
-    EXPECT_DOUBLE_EQ(a.links[i].a, b.links[i].a);
-    EXPECT_DOUBLE_EQ(a.links[i].d, b.links[i].d);
-    EXPECT_DOUBLE_EQ(a.links[i].theta_offset, b.links[i].theta_offset);
-    EXPECT_DOUBLE_EQ(a.links[i].min, b.links[i].min);
-    EXPECT_DOUBLE_EQ(a.links[i].max, b.links[i].max);
-    EXPECT_DOUBLE_EQ(a.links[i].max_speed, b.links[i].max_speed);
+    const DhLink& p = a.links[i];
+    const DhLink& q = b.links[i];
+    if (!near(p.alpha, q.alpha) || !near(p.a, q.a) || !near(p.d, q.d) ||
+        !near(p.theta_offset, q.theta_offset) || !near(p.min, q.min) || !near(p.max, q.max) ||
+        !near(p.max_speed, q.max_speed)) {
+      return ::testing::AssertionFailure() << "joint " << i + 1 << " differs";
+    }
   }
-  EXPECT_TRUE(a.tool.isApprox(b.tool, 1e-15));
-  EXPECT_EQ(a.workspace.min, b.workspace.min);
-  EXPECT_EQ(a.workspace.max, b.workspace.max);
+  if (!a.tool.isApprox(b.tool, 1e-15)) return ::testing::AssertionFailure() << "tools differ";
+  if (a.workspace.min != b.workspace.min || a.workspace.max != b.workspace.max) {
+    return ::testing::AssertionFailure() << "workspaces differ";
+  }
+  return ::testing::AssertionSuccess();
 }
 
 /// The message of the ConfigError that loading `yaml` throws, or "" when it does not throw.
@@ -351,8 +359,8 @@ TEST(MotionTime, SlowestJointAtHalfSpeed) {
 
 // No "arm" section gives the A465; so does the YAML section written out with its values.
 TEST(LoadArmGeometry, DefaultsAreTheA465) {
-  expect_same_geometry(load_arm_geometry(Config()), ArmGeometry::a465());
-  expect_same_geometry(load_arm_geometry(Config::parse(kDefaultsYaml)), ArmGeometry::a465());
+  EXPECT_TRUE(same_geometry(load_arm_geometry(Config()), ArmGeometry::a465()));
+  EXPECT_TRUE(same_geometry(load_arm_geometry(Config::parse(kDefaultsYaml)), ArmGeometry::a465()));
 }
 
 // Values in the file replace the defaults, degrees converted to radians.
