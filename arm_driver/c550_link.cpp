@@ -16,20 +16,27 @@ void C550Link::send(std::span<const uint8_t> bytes) {
   stats_.bytes_written += static_cast<int64_t>(bytes.size());
 }
 
-uint8_t C550Link::expect_byte(const char* what, milliseconds timeout) {
+uint8_t C550Link::expect_raw(const char* what, milliseconds timeout) {
+  const auto byte = line_.read_byte(timeout);
+  if (!byte) {
+    throw LinkError(std::string("no ") + what + " within " + std::to_string(timeout.count()) +
+                    " ms");
+  }
+  ++stats_.bytes_read;
+  return *byte;
+}
+
+uint8_t C550Link::expect_text(const char* what, milliseconds timeout) {
   for (;;) {
-    const auto byte = line_.read_byte(timeout);
-    if (!byte) throw LinkError(std::string("no ") + what + " within " +
-                               std::to_string(timeout.count()) + " ms");
-    ++stats_.bytes_read;
-    if (*byte != rapl::XON && *byte != rapl::XOFF) return *byte;
+    const uint8_t byte = expect_raw(what, timeout);
+    if (byte != rapl::XON && byte != rapl::XOFF) return byte;
   }
 }
 
 std::vector<uint8_t> C550Link::read_exact(size_t n, const char* what) {
   std::vector<uint8_t> bytes;
   bytes.reserve(n);
-  while (bytes.size() < n) bytes.push_back(expect_byte(what, timing_.byte_timeout));
+  while (bytes.size() < n) bytes.push_back(expect_raw(what, timing_.byte_timeout));
   return bytes;
 }
 
@@ -58,7 +65,7 @@ void C550Link::send_header(const AciHeader& header) {
     if (attempt) ++stats_.retries;
     send(bytes);
     try {
-      const uint8_t answer = expect_byte("answer to the ACI header", timing_.byte_timeout);
+      const uint8_t answer = expect_raw("answer to the ACI header", timing_.byte_timeout);
       if (answer == ACK) return;
     } catch (const LinkError&) {
       // time-out: send again
@@ -76,7 +83,7 @@ void C550Link::send_blocks(const std::vector<uint8_t>& data) {
       if (attempt) ++stats_.retries;
       send(frames[i]);
       try {
-        acknowledged = expect_byte("answer to an ACI block", timing_.byte_timeout) == ACK;
+        acknowledged = expect_raw("answer to an ACI block", timing_.byte_timeout) == ACK;
       } catch (const LinkError&) {
       }
     }
@@ -100,7 +107,7 @@ std::vector<uint8_t> C550Link::receive_blocks(int length) {
     for (int attempt = 0; attempt < timing_.retries && !received; ++attempt) {
       if (attempt) ++stats_.retries;
       try {
-        while (expect_byte("ACI block", timing_.byte_timeout) != STX) {
+        while (expect_raw("ACI block", timing_.byte_timeout) != STX) {
         }
         std::vector<uint8_t> frame{STX};
         const auto rest = read_exact(static_cast<size_t>(size) + 2, "ACI block byte");
@@ -121,7 +128,7 @@ std::vector<uint8_t> C550Link::receive_blocks(int length) {
                       std::to_string(timing_.retries) + " tries: " + last_error);
     }
   }
-  if (expect_byte("EOT ending the ACI read", timing_.byte_timeout) != EOT) {
+  if (expect_raw("EOT ending the ACI read", timing_.byte_timeout) != EOT) {
     throw LinkError("the ACI read did not end with EOT");
   }
   const uint8_t eot = EOT;
@@ -147,7 +154,28 @@ void C550Link::write_memory(uint8_t memtype, uint16_t segment, uint16_t offset,
   send_blocks(data);
 }
 
+void C550Link::leave_command_mode() {
+  const uint8_t interrupt = rapl::CTRL_C;
+  send({&interrupt, 1});
+  std::this_thread::sleep_for(timing_.session_settle);
+  const std::string help = "HELP\r";
+  send({reinterpret_cast<const uint8_t*>(help.data()), help.size()});
+  drain(std::chrono::seconds(2));
+  const uint8_t leave[] = {rapl::CTRL_Z, rapl::CTRL_Z};
+  send(leave);
+  std::this_thread::sleep_for(timing_.session_settle);
+  line_.discard_input();
+}
+
+void C550Link::drain(std::chrono::steady_clock::duration at_most) {
+  const auto give_up = std::chrono::steady_clock::now() + at_most;
+  while (std::chrono::steady_clock::now() < give_up && line_.read_byte(timing_.byte_timeout)) {
+    ++stats_.bytes_read;
+  }
+}
+
 void C550Link::open_session() {
+  leave_command_mode();
   read_memory(kMemSession, 0, 0, 1);
   std::this_thread::sleep_for(timing_.session_settle);
   const uint8_t interrupt = rapl::CTRL_C;
@@ -169,7 +197,7 @@ void C550Link::echo_line(const std::string& text) {
     send({&byte, 1});
     uint8_t echo = 0;
     try {
-      echo = expect_byte("echo", timing_.byte_timeout);
+      echo = expect_text("echo", timing_.byte_timeout);
     } catch (const LinkError& e) {
       resynchronise();
       throw LinkError("'" + text + "': " + e.what() + " of " + byte_name(byte));
@@ -195,7 +223,7 @@ rapl::Reply C550Link::command(const std::string& text, milliseconds reply_timeou
   rapl::ReplyReader reader;
   try {
     while (!reader.complete()) {
-      reader.feed(expect_byte(reader.acknowledged() ? "reply byte" : "ACK",
+      reader.feed(expect_text(reader.acknowledged() ? "reply byte" : "ACK",
                               reader.acknowledged() ? timing_.byte_timeout : reply_timeout));
     }
   } catch (const std::exception& e) {  // LinkError (time-out) or RaplError (garbled)

@@ -67,7 +67,9 @@ class C550Link {
   void write_memory(uint8_t memtype, uint16_t segment, uint16_t offset,
                     const std::vector<uint8_t>& data);
 
-  /// Opens the host session: enquiry, the one-byte 0x48 read, ^C, then `NOH`.
+  /// Opens the host session: first leave_command_mode() (a driver that died mid-session leaves the
+  /// controller in RAPL-II mode, where an enquiry is just text), then the enquiry, the one-byte
+  /// 0x48 read, ^C, and `NOH`.
   void open_session();
   /// Closes it: `HELP`, then 0x1A twice (the controller returns to ACI mode).
   void close_session();
@@ -86,6 +88,10 @@ class C550Link {
   /// `LLOC name`.
   rapl::Location read_location(const std::string& name);
 
+  /// ^C, `HELP`, ^Z ^Z without waiting for answers: returns a controller in RAPL-II mode to ACI
+  /// mode; in ACI mode these bytes are not frames and are ignored.
+  void leave_command_mode();
+
   /// ^C, then everything up to the prompt (or a quiet byte_timeout) is dropped.
   void resynchronise();
 
@@ -94,7 +100,11 @@ class C550Link {
 
  private:
   void send(std::span<const uint8_t> bytes);
-  uint8_t expect_byte(const char* what, milliseconds timeout);
+  void drain(std::chrono::steady_clock::duration at_most);
+  /// One byte as it came: the ACI layer is binary, so 0x11 and 0x13 are data there.
+  uint8_t expect_raw(const char* what, milliseconds timeout);
+  /// One byte of RAPL-II text, XON/XOFF dropped (c550-aci.md: "dropped on read").
+  uint8_t expect_text(const char* what, milliseconds timeout);
   std::vector<uint8_t> read_exact(size_t n, const char* what);
   void send_header(const aci::AciHeader& header);
   void send_blocks(const std::vector<uint8_t>& data);

@@ -363,6 +363,13 @@ TEST(LoadArmGeometry, DefaultsAreTheA465) {
   EXPECT_TRUE(same_geometry(load_arm_geometry(Config::parse(kDefaultsYaml)), ArmGeometry::a465()));
 }
 
+// The shipped config/stereograsp.yaml describes the A465 of ArmGeometry::a465().
+TEST(LoadArmGeometry, ShippedConfigIsTheA465) {
+  const Config shipped = Config::load(std::string(SG_SOURCE_DIR) + "/config/stereograsp.yaml");
+  ASSERT_TRUE(shipped.has("arm.dh"));
+  EXPECT_TRUE(same_geometry(load_arm_geometry(shipped), ArmGeometry::a465()));
+}
+
 // Values in the file replace the defaults, degrees converted to radians.
 TEST(LoadArmGeometry, ReadsValuesInDegreesAndMetres) {
   const ArmGeometry arm = load_arm_geometry(Config::parse(

@@ -1,0 +1,283 @@
+// sg-arm-driver and sg-c550-sim as processes on a real pseudo-terminal, over real LCM: a move, a
+// gripper cycle, a rejected target, latest-wins under a burst, recovery after a disconnect, and
+// sg-arm-ctl at the bench.
+
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <sstream>
+#include <thread>
+
+#include "common/bus.hpp"
+#include "common/clock.hpp"
+#include "common/message_types.hpp"
+#include "tests/integration/multicast_guard.hpp"
+#include "tests/support/subprocess.hpp"
+
+namespace sg::test {
+namespace {
+
+using namespace std::chrono_literals;
+using stereograsp::arm_cmd_t;
+using stereograsp::arm_status_t;
+using stereograsp::sim_arm_state_t;
+constexpr double kPi = 3.14159265358979323846;
+
+/// The RAPL-II lines sg-c550-sim logged (--log-commands): the third tab-separated field.
+std::vector<std::string> logged_commands(const std::string& path) {
+  std::vector<std::string> lines;
+  std::istringstream in(read_text(path));
+  for (std::string line; std::getline(in, line);) {
+    const auto second_tab = line.find('\t', line.find('\t') + 1);
+    if (second_tab != std::string::npos) lines.push_back(line.substr(second_tab + 1));
+  }
+  return lines;
+}
+
+/// Lines starting with `prefix`.
+std::vector<std::string> starting_with(const std::vector<std::string>& lines,
+                                       const std::string& prefix) {
+  std::vector<std::string> out;
+  for (const auto& l : lines) {
+    if (l.rfind(prefix, 0) == 0) out.push_back(l);
+  }
+  return out;
+}
+
+/// The first repeated line, or "" when every line is distinct.
+std::string first_repeat(const std::vector<std::string>& lines) {
+  std::map<std::string, int> seen;
+  for (const auto& l : lines) {
+    if (++seen[l] == 2) return l;
+  }
+  return "";
+}
+
+/// A tool-down Cartesian move; yaw = azimuth + pi keeps joint 6 away from its +-180 deg limit.
+arm_cmd_t move_to(int64_t sequence, double x, double y, double z) {
+  arm_cmd_t c{};
+  c.utime = now_utime();
+  c.sequence = sequence;
+  c.mode = arm_cmd_t::MODE_CARTESIAN;
+  c.position[0] = x;
+  c.position[1] = y;
+  c.position[2] = z;
+  c.orientation[0] = kPi;
+  c.orientation[2] = std::atan2(y, x) + kPi;
+  c.gripper = arm_cmd_t::GRIPPER_KEEP;
+  c.speed = 0.5;
+  c.sender = "arm_test";
+  return c;
+}
+
+arm_cmd_t gripper(int64_t sequence, int8_t action) {
+  arm_cmd_t c{};
+  c.utime = now_utime();
+  c.sequence = sequence;
+  c.mode = arm_cmd_t::MODE_GRIPPER_ONLY;
+  c.gripper = action;
+  c.speed = 0.5;
+  c.sender = "arm_test";
+  return c;
+}
+
+/// sg-c550-sim on a pseudo-terminal (linked at dir/c550), sg-arm-driver on it, and a bus that
+/// keeps the newest ARM_STATUS and SIM_ARM_STATE.
+class ArmRig {
+ public:
+  ArmRig(int port, std::vector<std::string> sim_flags)
+      : dir_(make_temp_dir()), url_(test_url(port)), bus_(url_) {
+    bus_.subscribe<arm_status_t>("ARM_STATUS", [this](const arm_status_t& s, const ReceiveInfo&) {
+      status_ = s;
+      ++status_count_;
+      if (s.state == arm_status_t::STATE_DISCONNECTED) saw_disconnected_ = true;
+    });
+    bus_.subscribe<sim_arm_state_t>(
+        "SIM_ARM_STATE", [this](const sim_arm_state_t& s, const ReceiveInfo&) { truth_ = s; });
+    std::vector<std::string> sim = {program("sg-c550-sim"),
+                                    "--lcm-url",
+                                    url_,
+                                    "--link",
+                                    device(),
+                                    "--log-commands",
+                                    command_log(),
+                                    "--delay-min",
+                                    "0.3",
+                                    "--delay-max",
+                                    "0.4",
+                                    "--speed",
+                                    "100"};
+    sim.insert(sim.end(), sim_flags.begin(), sim_flags.end());
+    sim_ = std::make_unique<Child>(sim);
+    for (int i = 0; i < 100 && !std::filesystem::exists(device()); ++i)
+      std::this_thread::sleep_for(50ms);
+    driver_ = std::make_unique<Child>(std::vector<std::string>{
+        program("sg-arm-driver"), "--lcm-url", url_, "--device", device()});
+  }
+
+  ~ArmRig() {
+    driver_->signal(SIGINT);
+    sim_->signal(SIGINT);
+    driver_->wait(5s);
+    sim_->wait(5s);
+  }
+
+  std::string device() const { return dir_ + "/c550"; }
+  std::string command_log() const { return dir_ + "/commands.log"; }
+  const std::string& url() const { return url_; }
+  Bus& bus() { return bus_; }
+  const arm_status_t& status() const { return status_; }
+  const sim_arm_state_t& truth() const { return truth_; }
+  bool saw_disconnected() const { return saw_disconnected_; }
+
+  /// Handles messages until `done()` holds or `timeout` passes; returns done().
+  bool wait_until(const std::function<bool()>& done, std::chrono::seconds timeout) {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    while (!done() && std::chrono::steady_clock::now() < deadline) bus_.handle(20ms);
+    return done();
+  }
+
+  /// Waits for the driver's first status with the controller connected.
+  bool wait_connected() {
+    return wait_until(
+        [&] { return status_count_ > 0 && status_.state != arm_status_t::STATE_DISCONNECTED; },
+        20s);
+  }
+
+  /// Waits until `sequence` is executed and the arm is at rest.
+  bool wait_executed(int64_t sequence, std::chrono::seconds timeout = 20s) {
+    return wait_until(
+        [&] {
+          return status_.last_executed_sequence == sequence &&
+                 status_.state == arm_status_t::STATE_IDLE;
+        },
+        timeout);
+  }
+
+ private:
+  std::string dir_;
+  std::string url_;
+  Bus bus_;
+  std::unique_ptr<Child> sim_;
+  std::unique_ptr<Child> driver_;
+  arm_status_t status_{};
+  sim_arm_state_t truth_{};
+  int status_count_ = 0;
+  bool saw_disconnected_ = false;
+};
+
+/// Distance from the status's tool centre point to (x, y, z).
+double tool_error(const arm_status_t& s, double x, double y, double z) {
+  return std::hypot(s.tool_position[0] - x, s.tool_position[1] - y, s.tool_position[2] - z);
+}
+
+// A Cartesian move reaches the target: ARM_STATUS and the simulator's true state agree within 1 mm.
+TEST(ArmProcesses, MoveGripperCycleAndRejection) {
+  ASSERT_TRUE(multicast_available(7916));
+  ArmRig rig(7916, {});
+  ASSERT_TRUE(rig.wait_connected());
+  rig.bus().publish("ARM_COMMAND", move_to(1, 0.45, 0.10, 0.30));
+  ASSERT_TRUE(rig.wait_executed(1)) << rig.status().error << rig.status().rejection_reason;
+  EXPECT_LT(tool_error(rig.status(), 0.45, 0.10, 0.30), 1e-3);
+  ASSERT_TRUE(rig.wait_until(
+      [&] {
+        const auto& t = rig.truth();
+        return std::hypot(t.tool_position[0] - 0.45, t.tool_position[1] - 0.10,
+                          t.tool_position[2] - 0.30) < 1e-3;
+      },
+      10s));
+  EXPECT_GT(rig.status().interaction_time, 0.3);
+
+  // Gripper: close, then open; the status and the simulator's finger opening follow.
+  rig.bus().publish("ARM_COMMAND", gripper(2, arm_cmd_t::GRIPPER_CLOSE));
+  ASSERT_TRUE(rig.wait_executed(2));
+  EXPECT_TRUE(
+      rig.wait_until([&] { return rig.status().gripper == arm_status_t::GRIPPER_CLOSED; }, 5s));
+  EXPECT_TRUE(rig.wait_until([&] { return rig.truth().gripper_opening < 1e-3; }, 5s));
+  rig.bus().publish("ARM_COMMAND", gripper(3, arm_cmd_t::GRIPPER_OPEN));
+  ASSERT_TRUE(rig.wait_executed(3));
+  EXPECT_TRUE(
+      rig.wait_until([&] { return rig.status().gripper == arm_status_t::GRIPPER_OPEN; }, 5s));
+  EXPECT_TRUE(rig.wait_until([&] { return rig.truth().gripper_opening > 0.079; }, 5s));
+
+  // Out of reach inside the workspace box: rejected with a reason, nothing reaches the controller.
+  const size_t before = starting_with(logged_commands(rig.command_log()), "MA").size();
+  rig.bus().publish("ARM_COMMAND", move_to(4, 0.85, 0.85, 1.20));
+  ASSERT_TRUE(rig.wait_until([&] { return rig.status().last_rejected_sequence == 4; }, 10s));
+  EXPECT_FALSE(rig.status().rejection_reason.empty());
+  EXPECT_EQ(rig.status().last_executed_sequence, 3);
+  // A stale sequence number is refused too.
+  rig.bus().publish("ARM_COMMAND", move_to(2, 0.40, 0.0, 0.40));
+  ASSERT_TRUE(rig.wait_until([&] { return rig.status().last_rejected_sequence == 2; }, 10s));
+  std::this_thread::sleep_for(1s);
+  EXPECT_EQ(starting_with(logged_commands(rig.command_log()), "MA").size(), before);
+}
+
+// A burst of 100 commands while one interaction is in flight: the newest wins, no backlog, and no
+// command reaches the controller twice.
+TEST(ArmProcesses, LatestWinsUnderABurst) {
+  ASSERT_TRUE(multicast_available(7917));
+  ArmRig rig(7917, {});
+  ASSERT_TRUE(rig.wait_connected());
+  for (int i = 1; i <= 100; ++i) {
+    const double a = 0.01 * i;
+    rig.bus().publish("ARM_COMMAND", move_to(i, 0.50 * std::cos(a), 0.50 * std::sin(a), 0.30));
+    std::this_thread::sleep_for(2ms);
+  }
+  ASSERT_TRUE(rig.wait_executed(100, 30s)) << rig.status().error;
+  EXPECT_LT(tool_error(rig.status(), 0.50 * std::cos(1.0), 0.50 * std::sin(1.0), 0.30), 1e-3);
+  const auto moves = starting_with(logged_commands(rig.command_log()), "MA");
+  EXPECT_GE(moves.size(), 1u);
+  EXPECT_LE(moves.size(), 4u) << "a backlog: " << moves.size() << " moves for a 0.2 s burst";
+  EXPECT_EQ(first_repeat(moves), "");
+}
+
+// The line goes away for a second mid-session: the driver reports DISCONNECTED, reconnects, and
+// every command is executed at most once, with the newest executed in the end.
+TEST(ArmProcesses, RecoversAfterADisconnect) {
+  ASSERT_TRUE(multicast_available(7918));
+  ArmRig rig(7918, {"--disconnect-after", "3", "--reconnect-after", "1"});
+  ASSERT_TRUE(rig.wait_connected());
+  int64_t sequence = 0;
+  const auto start = std::chrono::steady_clock::now();
+  while (std::chrono::steady_clock::now() - start < 7s) {
+    ++sequence;
+    const double a = 0.2 * static_cast<double>(sequence);
+    rig.bus().publish("ARM_COMMAND",
+                      move_to(sequence, 0.50 * std::cos(a), 0.50 * std::sin(a), 0.35));
+    rig.wait_until([] { return false; }, 1s);
+  }
+  ASSERT_TRUE(rig.wait_executed(sequence, 30s)) << rig.status().error;
+  EXPECT_TRUE(rig.saw_disconnected());
+  const double a = 0.2 * static_cast<double>(sequence);
+  EXPECT_LT(tool_error(rig.status(), 0.50 * std::cos(a), 0.50 * std::sin(a), 0.35), 1e-3);
+  const auto commands = logged_commands(rig.command_log());
+  EXPECT_GE(starting_with(commands, "NOH").size(), 2u) << "no second session after the disconnect";
+  EXPECT_EQ(first_repeat(starting_with(commands, "MA")), "");
+}
+
+// sg-arm-ctl at the bench: `move X Y Z --wait` returns once the arm is there; `status` prints it.
+TEST(ArmProcesses, ArmCtlMovesTheArm) {
+  ASSERT_TRUE(multicast_available(7919));
+  ArmRig rig(7919, {});
+  ASSERT_TRUE(rig.wait_connected());
+  const ProcessResult moved = run(
+      {program("sg-arm-ctl"), "--lcm-url", rig.url(), "move", "0.5", "0.1", "0.3", "--wait"}, 30s);
+  EXPECT_EQ(moved.exit_code, 0) << moved.out << moved.err;
+  EXPECT_NE(moved.out.find("executed"), std::string::npos) << moved.out;
+  ASSERT_TRUE(rig.wait_until([&] { return tool_error(rig.status(), 0.5, 0.1, 0.3) < 1e-3; }, 10s));
+  const ProcessResult shown = run({program("sg-arm-ctl"), "--lcm-url", rig.url(), "status"}, 10s);
+  EXPECT_EQ(shown.exit_code, 0) << shown.err;
+  EXPECT_NE(shown.out.find("(0.5000, 0.1000, 0.3000)"), std::string::npos) << shown.out;
+  const ProcessResult refused =
+      run({program("sg-arm-ctl"), "--lcm-url", rig.url(), "move", "3", "0", "0.3"}, 30s);
+  EXPECT_NE(refused.exit_code, 0);
+  EXPECT_NE((refused.out + refused.err).find("rejected"), std::string::npos)
+      << refused.out << refused.err;
+}
+
+}  // namespace
+}  // namespace sg::test
