@@ -1,5 +1,7 @@
 #include "arm_driver/c550_link.hpp"
 
+#include <spdlog/spdlog.h>
+
 #include <thread>
 
 namespace sg::arm {
@@ -231,6 +233,9 @@ rapl::Reply C550Link::command(const std::string& text, milliseconds reply_timeou
     throw LinkError("reply to '" + text + "': " + e.what());
   }
   rapl::Reply reply = reader.reply();
+  spdlog::debug("C550: '{}' -> {}", text,
+                reply.error ? *reply.error
+                            : (reply.lines.empty() ? std::string("ACK") : reply.lines.front()));
   if (reply.error) throw ControllerError("'" + text + "': " + *reply.error);
   return reply;
 }

@@ -25,11 +25,16 @@ using Status = stereograsp::arm_status_t;
 
 const char* state_name(int8_t state) {
   switch (state) {
-    case Status::STATE_IDLE: return "IDLE";
-    case Status::STATE_MOVING: return "MOVING";
-    case Status::STATE_ERROR: return "ERROR";
-    case Status::STATE_DISCONNECTED: return "DISCONNECTED";
-    default: return "?";
+    case Status::STATE_IDLE:
+      return "IDLE";
+    case Status::STATE_MOVING:
+      return "MOVING";
+    case Status::STATE_ERROR:
+      return "ERROR";
+    case Status::STATE_DISCONNECTED:
+      return "DISCONNECTED";
+    default:
+      return "?";
   }
 }
 
@@ -86,7 +91,8 @@ int send(sg::Bus& bus, const Cmd& command, bool wait_idle, double timeout) {
     bus.handle(std::chrono::milliseconds(50));
   }
   if (!have) {
-    throw std::runtime_error("no ARM_STATUS on this bus: is sg-arm-driver running (same --lcm-url)?");
+    throw std::runtime_error(
+        "no ARM_STATUS on this bus: is sg-arm-driver running (same --lcm-url)?");
   }
   if (rejected) {
     std::printf("command #%lld rejected: %s\n", static_cast<long long>(command.sequence),
@@ -128,14 +134,17 @@ int main(int argc, char** argv) {
   sg::add_common_options(app, common);
   double speed = 0.5, timeout = 10;
   bool wait_idle = false, degrees = false, follow = false;
-  std::vector<double> xyz, rpy{std::numbers::pi, 0, 0}, joints;
+  std::vector<double> xyz, rpy, joints;
   app.add_option("--speed", speed, "fraction of the joint speed limits, (0, 1] (default 0.5)");
   app.add_option("--timeout", timeout, "seconds to wait for the driver (default 10)");
   app.add_flag("--wait", wait_idle, "wait until the arm is at rest");
   app.require_subcommand(1);
   auto* move = app.add_subcommand("move", "move the tool centre point to X Y Z (m)");
   move->add_option("X Y Z", xyz, "robot base frame, metres")->expected(3)->required();
-  move->add_option("--rpy", rpy, "tool roll pitch yaw, radians (default pi 0 0: pointing down)")
+  move->add_option(
+          "--rpy", rpy,
+          "tool roll pitch yaw, radians (default: pointing down, the gripper square to the "
+          "base, pi 0 atan2(Y,X)+pi, which keeps joint 6 near zero)")
       ->expected(3);
   auto* joint_cmd = app.add_subcommand("joints", "move to joint angles J1..J6 (radians)");
   joint_cmd->add_option("J", joints, "six joint angles")->expected(6)->required();
@@ -154,10 +163,14 @@ int main(int argc, char** argv) {
     Cmd c = make_command(Cmd::MODE_STOP, speed);
     if (*move) {
       c.mode = Cmd::MODE_CARTESIAN;
+      if (rpy.empty())
+        rpy = {std::numbers::pi, 0,
+               std::remainder(std::atan2(xyz[1], xyz[0]) + std::numbers::pi, 2 * std::numbers::pi)};
       for (int i = 0; i < 3; ++i) c.position[i] = xyz[i], c.orientation[i] = rpy[i];
     } else if (*joint_cmd) {
       c.mode = Cmd::MODE_JOINTS;
-      for (int i = 0; i < 6; ++i) c.joints[i] = degrees ? joints[i] * std::numbers::pi / 180 : joints[i];
+      for (int i = 0; i < 6; ++i)
+        c.joints[i] = degrees ? joints[i] * std::numbers::pi / 180 : joints[i];
     } else if (*open || *close) {
       c.mode = Cmd::MODE_GRIPPER_ONLY;
       c.gripper = *open ? Cmd::GRIPPER_OPEN : Cmd::GRIPPER_CLOSE;
