@@ -123,7 +123,9 @@ Location parse_location(const Reply& reply) {
     }
     if (values.size() != 6) continue;
     Location location;
-    location.name = line.substr(0, line.find(' '));
+    // The name as sent (split.verb is upper-cased), after the separators split_command skips.
+    const std::string_view named = std::string_view(line).substr(line.find_first_not_of(", \t"));
+    location.name = std::string(named.substr(0, named.find(' ')));
     for (int i = 0; i < 3; ++i) location.xyz[i] = from_inches(values[i]);
     for (int i = 0; i < 3; ++i) location.rpy[i] = from_degrees(values[3 + i]);
     return location;

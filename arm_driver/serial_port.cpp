@@ -130,14 +130,15 @@ std::optional<uint8_t> SerialPort::read_byte(std::chrono::microseconds timeout) 
   if (!(p.revents & POLLIN)) gone("hung up");
   buffer_.resize(256);
   const ssize_t n = ::read(fd_, buffer_.data(), buffer_.size());
-  if (n == 0) gone("end of file");
-  if (n < 0) {
-    if (errno == EAGAIN || errno == EINTR) {
-      buffer_.clear();
-      next_ = 0;
-      return std::nullopt;
-    }
-    gone(std::string("read failed: ") + std::strerror(errno));
+  if (n <= 0) {
+    const int error = errno;
+    // Nothing was read: leave no unread bytes behind, or the next call would return the stale
+    // or zero-filled buffer instead of reporting the device gone again.
+    buffer_.clear();
+    next_ = 0;
+    if (n == 0) gone("end of file");
+    if (error == EAGAIN || error == EINTR) return std::nullopt;
+    gone(std::string("read failed: ") + std::strerror(error));
   }
   buffer_.resize(static_cast<size_t>(n));
   next_ = 1;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <set>
 #include <stdexcept>
 #include <utility>
 
@@ -94,12 +95,14 @@ std::vector<C550Emulator::Chunk> C550Emulator::take_output_chunks(double t) {
 }
 
 double C550Emulator::next_output_time() const {
-  return output_.empty() ? std::numeric_limits<double>::infinity() : output_.front().due;
+  if (!output_.empty()) return output_.front().due;
+  return deferred_ ? deferred_->due : std::numeric_limits<double>::infinity();
 }
 
 std::vector<std::string> C550Emulator::take_events() { return std::exchange(events_, {}); }
 
 void C550Emulator::pump(double now) {
+  run_deferred(now);
   // Bytes that arrived while a reply was held are handled once it has gone, in order.
   while (!input_.empty() && hold_until_ <= now) {
     const Input in = input_.front();
@@ -332,6 +335,13 @@ void C550Emulator::rapl_byte(uint8_t byte, double t) {
 void C550Emulator::end_line(double t) {
   const std::string line = std::exchange(line_, {});
   const size_t length = std::exchange(line_length_, 0);
+  if (length <= rapl::kMaxLine && acts_after_delay(line)) {
+    // The controller digests a motion command for the interaction delay, then acts and answers.
+    executed_.push_back(line);
+    deferred_ = Deferred{line, t + controller_.interaction_delay()};
+    hold_until_ = std::max(hold_until_, deferred_->due);
+    return;
+  }
   Answer answer;
   if (length > rapl::kMaxLine) {
     executed_.push_back(line + "...");
@@ -341,13 +351,28 @@ void C550Emulator::end_line(double t) {
     executed_.push_back(line);
     answer = execute(line, t);
   }
+  reply(line, answer, t);
+}
+
+bool C550Emulator::acts_after_delay(const std::string& line) {
+  static const std::set<std::string> kMotion = {"MA", "MOVE", "READY", "OPEN", "CLOSE", "JOINT"};
+  return kMotion.contains(rapl::split_command(line).verb);
+}
+
+void C550Emulator::run_deferred(double now) {
+  if (!deferred_ || deferred_->due > now) return;
+  const Deferred d = *std::exchange(deferred_, std::nullopt);
+  reply(d.line, execute(d.line, d.due), d.due);
+}
+
+void C550Emulator::reply(const std::string& line, const Answer& answer, double t) {
   for (const std::string& text : answer.lines) {
     if (text.starts_with("***")) event("'" + line + "': " + text);
   }
   const double due = std::max(t, answer.due.value_or(t));
   emit({rapl::ACK}, due, true);
   std::string text;
-  for (const std::string& reply : answer.lines) text += "\r\n" + reply;
+  for (const std::string& line_text : answer.lines) text += "\r\n" + line_text;
   text += rapl::kPrompt;
   emit({text.begin(), text.end()}, due);
   hold_until_ = std::max(hold_until_, due);
@@ -432,9 +457,9 @@ C550Emulator::Answer C550Emulator::help(const std::string& rest, double /*t*/) {
   return {};
 }
 
-C550Emulator::Answer C550Emulator::motion(const CommandResult& result, double t) {
+C550Emulator::Answer C550Emulator::motion(const CommandResult& result, double /*t*/) {
   if (!result) return {{result.error}, {}};
-  return {{}, t + controller_.interaction_delay()};
+  return {};
 }
 
 C550Emulator::Answer C550Emulator::point(const std::string& rest, double /*t*/) {

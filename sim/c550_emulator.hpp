@@ -33,12 +33,13 @@
 ///    EOT and other control bytes are dropped silently (not echoed, not stored); XON/XOFF too.
 ///    ^C clears the line and answers the prompt `\r\n>>` (no ACK). After CR the reply is ACK,
 ///    then each text line preceded by `\r\n`, then `\r\n>>` (an empty line gets ACK and the
-///    prompt). MA, MOVE, READY, OPEN, CLOSE and JOINT that the controller accepts hold their
-///    whole reply (ACK, text, prompt) until t + interaction_delay(); the motion itself starts at
-///    t. A motion command refused (bad arguments, limits, out of range) answers at once with its
-///    `***` line. FINISH answers when the arm and gripper have settled. Everything else answers
-///    at once. While a reply is held every byte that arrives (even ^C) is buffered, not echoed,
-///    and processed in order after the reply has gone, as if it had arrived then.
+///    prompt). MA, MOVE, READY, OPEN, CLOSE and JOINT are digested for interaction_delay(): the
+///    controller executes them at t + delay (the motion or gripper stroke starts then, a CLOSE
+///    grasps the ball where it is then) and only then answers, with ACK and prompt or with the
+///    `***` line of a refusal (bad arguments, limits, out of range). FINISH answers when the arm
+///    and gripper have settled. Everything else answers at once. While a reply is held every byte
+///    that arrives (even ^C) is buffered, not echoed, and processed in order after the reply has
+///    gone, as if it had arrived then.
 ///  - A line of more than rapl::kMaxLine characters is echoed in full and answered at its CR by
 ///    `*** 10 LINE TOO LONG ...`. After HELP, two 0x1A (^Z) in a row return to ACI mode; ^Z at
 ///    any other time is dropped.
@@ -132,7 +133,13 @@ class C550Emulator {
   void rapl_byte(uint8_t byte, double t);
   void end_line(double t);
   Answer execute(const std::string& line, double t);
-  /// A motion command's answer: its error at once, or nothing after interaction_delay().
+  /// True for the motion commands the controller executes after interaction_delay().
+  static bool acts_after_delay(const std::string& line);
+  /// Executes the held motion command once its time has come.
+  void run_deferred(double now);
+  /// ACK, the reply lines and the prompt, due at `t` (or the answer's own time).
+  void reply(const std::string& line, const Answer& answer, double t);
+  /// A motion command's answer: its error or nothing.
   Answer motion(const CommandResult& result, double t);
   // One per command: `rest` is the text after the verb, trimmed. Bad arguments throw RaplError.
   Answer speed(const std::string& rest, double t);
@@ -157,6 +164,12 @@ class C550Emulator {
   std::deque<Input> input_;
   std::deque<Output> output_;
   double hold_until_ = -std::numeric_limits<double>::infinity();
+  /// A motion command received and not yet executed: it runs, and answers, at `due`.
+  struct Deferred {
+    std::string line;
+    double due = 0;
+  };
+  std::optional<Deferred> deferred_;
   std::vector<std::string> events_;
 
   // ACI state

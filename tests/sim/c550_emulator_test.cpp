@@ -225,14 +225,14 @@ TEST_F(C550EmulatorTest, W2ReplyParsesToTheControllerJoints) {
   for (int i = 0; i < 6; ++i) EXPECT_NEAR(q[static_cast<size_t>(i)], truth[i], 1e-6);
 }
 
-// MA's reply is held for the interaction delay; bytes sent meanwhile wait for it.
+// MA is digested for the interaction delay, then executed and answered; bytes sent meanwhile wait.
 TEST_F(C550EmulatorTest, MotionAckArrivesAfterTheInteractionDelay) {
   open_session();
   C550Controller twin(arm::ArmGeometry::a465());  // same seed: the same first delay
   const double delay = twin.interaction_delay();
   const double sent = t;
-  EXPECT_EQ(command("MA 10,0,90,0,90,0"), "");  // nothing yet
-  EXPECT_TRUE(controller.moving(sent));         // the motion started at the CR
+  EXPECT_EQ(command("MA 10,0,90,0,90,0"), "");           // nothing yet
+  EXPECT_FALSE(controller.moving(sent + delay - 1e-6));  // the motion starts after the delay
   EXPECT_NEAR(c550.next_output_time(), sent + delay, 1e-12);
   EXPECT_GE(c550.next_output_time(), sent + 0.72);
   t = sent + 0.5;
@@ -240,12 +240,15 @@ TEST_F(C550EmulatorTest, MotionAckArrivesAfterTheInteractionDelay) {
   EXPECT_EQ(c550.take_output(sent + delay - 1e-9), Bytes{});
   t = sent + delay;
   EXPECT_EQ(text(c550.take_output(t)), "\x06\r\n>>W2");  // the reply, then the held echoes
+  EXPECT_TRUE(controller.moving(t));
 }
 
-// A refused MA answers at once with *** 73 and the prompt.
-TEST_F(C550EmulatorTest, MotionOutsideLimitsIsRefusedAtOnce) {
+// A refused MA answers after the delay with *** 73 and the prompt, and the arm stays.
+TEST_F(C550EmulatorTest, MotionOutsideLimitsIsRefusedAfterTheDelay) {
   open_session();
-  const rapl::Reply reply = parse(command("MA 0,120,90,0,90,0"));
+  EXPECT_EQ(command("MA 0,120,90,0,90,0"), "");
+  t += 1.0;
+  const rapl::Reply reply = parse(text(c550.take_output(t)));
   ASSERT_TRUE(reply.error);
   EXPECT_TRUE(reply.error->starts_with("*** 73 JOINT LIMIT: joint 2")) << *reply.error;
   EXPECT_FALSE(controller.moving(t));
@@ -256,7 +259,7 @@ TEST_F(C550EmulatorTest, UnknownCommandGivesErrorLineAndPrompt) {
   open_session();
   const std::string reply = command("FROB 3");
   EXPECT_EQ(reply, "\x06\r\n*** 10 UNKNOWN COMMAND 'FROB'\r\n>>");
-  EXPECT_TRUE(parse(command("MA 1,2,3")).error->starts_with("*** 10 MA: expected 6 numbers"));
+  EXPECT_TRUE(parse(command("MA 1,2,3", 1.0)).error->starts_with("*** 10 MA: expected 6 numbers"));
   EXPECT_TRUE(parse(command("SPEED fast")).error->starts_with("*** 10 SPEED"));
   EXPECT_TRUE(parse(command("SPEED 150")).error->starts_with("*** 10 SPEED 150"));
 }
@@ -275,7 +278,7 @@ TEST_F(C550EmulatorTest, PointMoveAndLlocRoundTripInInchesAndDegrees) {
   const Eigen::Isometry3d tcp = controller.tool_pose(t);
   EXPECT_NEAR((tcp.translation() - xyz).norm(), 0.0, 1e-4);
   EXPECT_TRUE(parse(command("LLOC other")).error->starts_with("*** 10 LLOC"));
-  EXPECT_TRUE(parse(command("MOVE other")).error->starts_with("*** 10 MOVE"));
+  EXPECT_TRUE(parse(command("MOVE other", 1.0)).error->starts_with("*** 10 MOVE"));
 }
 
 // ^C drops the typed line and answers the prompt; nothing is executed.
