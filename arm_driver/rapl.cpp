@@ -13,6 +13,7 @@ namespace {
 std::string fixed4(double value) {
   char text[32];
   std::snprintf(text, sizeof text, "%.4f", value);
+  if (std::string_view(text) == "-0.0000") return "0.0000";  // a rounding artefact, not a sign
   return text;
 }
 
@@ -135,7 +136,7 @@ Location parse_location(const Reply& reply) {
 
 CommandLine split_command(std::string_view line) {
   while (!line.empty() && is_separator(line.front())) line.remove_prefix(1);
-  const size_t space = line.find(' ');
+  const size_t space = line.find_first_of(" \t");
   CommandLine out;
   const std::string_view verb = line.substr(0, space);
   for (char c : verb) out.verb.push_back(static_cast<char>(std::toupper(static_cast<uint8_t>(c))));

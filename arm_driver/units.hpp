@@ -4,7 +4,8 @@
 /// radians (docs/architecture.md); the controller speaks inches and degrees, and these are the
 /// only conversions between the two.
 ///
-///     std::string text = sg::arm::format_fixed(sg::arm::to_inches(0.45));   // "17.7165"
+///     double inches = sg::arm::to_inches(0.45);          // 17.7165...
+///     double radians = sg::arm::from_degrees(90.0);      // pi / 2
 
 #include <numbers>
 

@@ -57,6 +57,12 @@ TEST(RaplCommands, MoveJointsRounding) {
   EXPECT_EQ(move_joints(q), "MA 12.3457,1.5000,-179.9999,0.2500,-7.1250,100.0000");
 }
 
+// A tiny negative angle prints as 0.0000, never "-0.0000" (-1e-9 rad rounds to zero).
+TEST(RaplCommands, NegativeZeroPrintsAsZero) {
+  const JointArray q{-1e-9, -0.0, 0.0, -0.00004 * kDeg, 0.00004 * kDeg, -0.00006 * kDeg};
+  EXPECT_EQ(move_joints(q), "MA 0.0000,0.0000,0.0000,0.0000,0.0000,-0.0001");
+}
+
 // MA refuses joints that are NaN or infinite.
 TEST(RaplCommands, MoveJointsRefusesNonFinite) {
   JointArray q{};
@@ -338,6 +344,9 @@ TEST(RaplSplitCommand, VerbAndRest) {
   const CommandLine ma = split_command("  MA 1,2,3,4,5,6");
   EXPECT_EQ(ma.verb, "MA");
   EXPECT_EQ(ma.rest, "1,2,3,4,5,6");
+  const CommandLine tabbed = split_command("MA\t1,2,3,4,5,6");  // a tab separates the verb too
+  EXPECT_EQ(tabbed.verb, "MA");
+  EXPECT_EQ(tabbed.rest, "1,2,3,4,5,6");
   const CommandLine w2 = split_command("w2");
   EXPECT_EQ(w2.verb, "W2");
   EXPECT_EQ(w2.rest, "");
