@@ -168,11 +168,6 @@ void ArmDriver::act(const ArmTarget& target) {
     link_->command("ABORT", timing.reply_timeout);
     return;
   }
-  const int percent = std::clamp(static_cast<int>(std::lround(target.speed * 100)), 1, 100);
-  if (percent != speed_percent_) {
-    link_->command(rapl::speed(percent), timing.reply_timeout);
-    speed_percent_ = percent;
-  }
   if (target.moves_arm()) {
     link_->command(rapl::move_joints(to_array(target.joints)), timing.motion_reply);
   } else if (target.mode == Cmd::MODE_HOME) {
@@ -190,7 +185,30 @@ void ArmDriver::execute(ArmTarget target) {
     s.state = Status::STATE_MOVING;
     s.source_utime = target.source_utime;
   });
+  // The command counts as executed once the action's CR is out; until the SPEED before it is
+  // through, link_->delivered() tells about the SPEED, not the action.
+  bool speed_done = false;
+  const auto record_executed = [&] {
+    attempts_ = 0;
+    update([&](Status& s) {
+      s.last_executed_sequence = target.sequence;
+      s.speed = speed_percent_ / 100.0;
+      if (target.mode == Cmd::MODE_STOP) commanded_.reset();
+      if (target.moves_arm()) commanded_ = target.joints;
+      if (target.mode == Cmd::MODE_HOME) commanded_.reset();
+      if (target.gripper == Cmd::GRIPPER_OPEN) s.gripper = Status::GRIPPER_OPEN;
+      if (target.gripper == Cmd::GRIPPER_CLOSE) s.gripper = Status::GRIPPER_CLOSED;
+      if (s.state == Status::STATE_ERROR) s.state = Status::STATE_MOVING;
+      s.error.clear();
+    });
+  };
   try {
+    const int percent = std::clamp(static_cast<int>(std::lround(target.speed * 100)), 1, 100);
+    if (target.mode != Cmd::MODE_STOP && percent != speed_percent_) {
+      link_->command(rapl::speed(percent), settings_.timing.reply_timeout);
+      speed_percent_ = percent;
+    }
+    speed_done = true;
     act(target);
   } catch (const ControllerError& e) {
     update([&](Status& s) {
@@ -203,28 +221,21 @@ void ArmDriver::execute(ArmTarget target) {
     read_joints();
     return;
   } catch (const LinkError& e) {
-    if (!link_->delivered()) {
+    if (!speed_done || !link_->delivered()) {
       requeue(std::move(target));
       throw;
     }
     spdlog::warn("command {}: {} (it reached the controller; not sent again)", target.sequence,
                  e.what());
   } catch (const LinkDown&) {
-    if (!link_->delivered()) requeue(std::move(target));
+    if (!speed_done || !link_->delivered()) {
+      requeue(std::move(target));
+    } else {
+      record_executed();  // it reached the controller before the line went: not sent again
+    }
     throw;
   }
-  attempts_ = 0;
-  update([&](Status& s) {
-    s.last_executed_sequence = target.sequence;
-    s.speed = speed_percent_ / 100.0;
-    if (target.mode == Cmd::MODE_STOP) commanded_.reset();
-    if (target.moves_arm()) commanded_ = target.joints;
-    if (target.mode == Cmd::MODE_HOME) commanded_.reset();
-    if (target.gripper == Cmd::GRIPPER_OPEN) s.gripper = Status::GRIPPER_OPEN;
-    if (target.gripper == Cmd::GRIPPER_CLOSE) s.gripper = Status::GRIPPER_CLOSED;
-    if (s.state == Status::STATE_ERROR) s.state = Status::STATE_MOVING;
-    s.error.clear();
-  });
+  record_executed();
   read_joints();
   const double total = seconds_since(start);
   const double inside = static_cast<TimedStream&>(*stream_).inside() - inside_before;
