@@ -61,9 +61,7 @@ void set_joints(const ArmGeometry& geometry, const Joints& q, Status& status) {
 }
 
 ArmDriver::ArmDriver(ArmGeometry geometry, DriverSettings settings, DeviceOpener open_device)
-    : validator_(std::move(geometry)),
-      settings_(settings),
-      open_device_(std::move(open_device)) {
+    : validator_(std::move(geometry)), settings_(settings), open_device_(std::move(open_device)) {
   status_.state = Status::STATE_DISCONNECTED;
   status_.gripper = Status::GRIPPER_UNKNOWN;
   status_.last_received_sequence = -1;
@@ -157,7 +155,8 @@ void ArmDriver::read_joints() {
     set_joints(validator_.geometry(), q, s);
     const bool moving =
         commanded_ && (q - *commanded_).cwiseAbs().maxCoeff() > settings_.arrived_tolerance;
-    if (s.state != Status::STATE_ERROR) s.state = moving ? Status::STATE_MOVING : Status::STATE_IDLE;
+    if (s.state != Status::STATE_ERROR)
+      s.state = moving ? Status::STATE_MOVING : Status::STATE_IDLE;
     if (!moving) s.source_utime = 0;
   });
 }
@@ -173,6 +172,7 @@ void ArmDriver::act(const ArmTarget& target) {
   } else if (target.mode == Cmd::MODE_HOME) {
     link_->command("READY", timing.motion_reply);
   }
+  motion_done_ = true;
   if (target.gripper != Cmd::GRIPPER_KEEP) {
     link_->command(target.gripper == Cmd::GRIPPER_OPEN ? "OPEN" : "CLOSE", timing.motion_reply);
   }
@@ -188,6 +188,15 @@ void ArmDriver::execute(ArmTarget target) {
   // The command counts as executed once the action's CR is out; until the SPEED before it is
   // through, link_->delivered() tells about the SPEED, not the action.
   bool speed_done = false;
+  motion_done_ = false;
+  // A motion delivered and a gripper action not: only the gripper action is tried again.
+  const auto requeue_rest = [&] {
+    if (motion_done_ && target.gripper != Cmd::GRIPPER_KEEP && target.mode != Cmd::MODE_STOP) {
+      if (target.moves_arm()) update([&](Status&) { commanded_ = target.joints; });
+      target.mode = Cmd::MODE_GRIPPER_ONLY;
+    }
+    requeue(std::move(target));
+  };
   const auto record_executed = [&] {
     attempts_ = 0;
     update([&](Status& s) {
@@ -222,14 +231,14 @@ void ArmDriver::execute(ArmTarget target) {
     return;
   } catch (const LinkError& e) {
     if (!speed_done || !link_->delivered()) {
-      requeue(std::move(target));
+      requeue_rest();
       throw;
     }
     spdlog::warn("command {}: {} (it reached the controller; not sent again)", target.sequence,
                  e.what());
   } catch (const LinkDown&) {
     if (!speed_done || !link_->delivered()) {
-      requeue(std::move(target));
+      requeue_rest();
     } else {
       record_executed();  // it reached the controller before the line went: not sent again
     }
@@ -262,7 +271,8 @@ std::optional<ArmTarget> ArmDriver::wait_for_work(std::stop_token stop) {
   std::unique_lock lock(mutex_);
   const bool moving = status_.state == Status::STATE_MOVING;
   const double poll = moving ? settings_.moving_poll : settings_.idle_poll;
-  wake_.wait_for(lock, stop, std::chrono::duration<double>(poll), [&] { return pending_.has_value(); });
+  wake_.wait_for(lock, stop, std::chrono::duration<double>(poll),
+                 [&] { return pending_.has_value(); });
   std::optional<ArmTarget> target = std::move(pending_);
   pending_.reset();
   return target;

@@ -28,12 +28,12 @@ namespace sg::arm {
 struct DriverSettings {
   int slave = 1;
   LinkTiming timing;
-  double moving_poll = 0.1;        ///< s between W2 reads while the arm moves and nothing waits
-  double idle_poll = 0.5;          ///< s between W2 reads at rest (also notices a lost line)
-  double reconnect_min = 0.2;      ///< s, first wait before reconnecting; doubles ...
-  double reconnect_max = 2.0;      ///< ... up to this
-  double arrived_tolerance = 1e-3; ///< rad: within this of the target, the arm is IDLE
-  int max_attempts = 3;            ///< sends of an undelivered command before it is rejected
+  double moving_poll = 0.1;         ///< s between W2 reads while the arm moves and nothing waits
+  double idle_poll = 0.5;           ///< s between W2 reads at rest (also notices a lost line)
+  double reconnect_min = 0.2;       ///< s, first wait before reconnecting; doubles ...
+  double reconnect_max = 2.0;       ///< ... up to this
+  double arrived_tolerance = 1e-3;  ///< rad: within this of the target, the arm is IDLE
+  int max_attempts = 3;             ///< sends of an undelivered command before it is rejected
 };
 
 using DeviceOpener = std::function<std::unique_ptr<ByteStream>()>;
@@ -72,7 +72,9 @@ class ArmDriver {
   std::unique_ptr<ByteStream> stream_;
   std::unique_ptr<C550Link> link_;
   int speed_percent_ = -1;  ///< the controller's SPEED, -1 before the first
-  int attempts_ = 0;        ///< sends of the pending command that did not reach the controller
+  int attempts_ = 0;
+  bool motion_done_ = false;  ///< this interaction's motion command has been delivered        ///<
+                              ///< sends of the pending command that did not reach the controller
 
   mutable std::mutex mutex_;
   std::condition_variable_any wake_;

@@ -496,5 +496,24 @@ TEST_F(ArmDriverTest, ResendsMoveWhenLineDropsAfterItsSpeed) {
   EXPECT_LT(distance(status(), {0.45, 0.0, 0.20}), 1e-3);
 }
 
+// A move with a CLOSE: the line goes down during the CLOSE's echo, after the MA ran. Only the
+// CLOSE is sent again: each of MA and CLOSE reaches the controller exactly once.
+TEST_F(ArmDriverTest, ResendsOnlyTheGripperWhenTheLineDropsAfterTheMove) {
+  start();
+  ASSERT_TRUE(connected());
+  Cmd command = move_to(1, 0.45, 0.0, 0.20);
+  command.gripper = Cmd::GRIPPER_CLOSE;
+  bench_->drop_when([](const std::string& line) { return line == "CL"; });
+
+  driver_->submit(command);
+
+  ASSERT_TRUE(done(1));
+  EXPECT_EQ(bench_->sessions(), 2);
+  EXPECT_EQ(bench_->executed_starting("MA ").size(), 1u);
+  EXPECT_EQ(bench_->executed_starting("CLOSE"), std::vector<std::string>{"CLOSE"});
+  EXPECT_EQ(status().gripper, stereograsp::arm_status_t::GRIPPER_CLOSED);
+  EXPECT_LT(distance(status(), {0.45, 0.0, 0.20}), 1e-3);
+}
+
 }  // namespace
 }  // namespace sg::arm
