@@ -60,7 +60,9 @@ class BurgAxis : public AxisModel {
   }
 
   void estimate() {
-    if (static_cast<int>(history_.size()) < p_.order + 3) return;  // keep the offline coefficients
+    const int needed =
+        p_.initial_coefficients.empty() ? p_.order + 3 : std::max(p_.order + 3, p_.online_after);
+    if (static_cast<int>(history_.size()) < needed) return;  // keep the offline coefficients
     const double m = mean_;
     centred_.assign(history_.begin(), history_.end());
     for (double& v : centred_) v -= m;

@@ -20,14 +20,17 @@ class AxisModel {
 };
 
 /// Burg's linear predictor (section 5.5): a sliding window of the last `window` samples with their
-/// mean removed; the coefficients are re-estimated at every measured sample once the window holds
-/// more than order + 3 (online adaptation), starting from offline-trained ones; forecasts apply
-/// eq. 27 recursively, feeding each prediction back.
+/// mean removed; the coefficients are re-estimated at every measured sample (online adaptation)
+/// once the window holds order + 3 samples, or, when offline-trained coefficients are given, once
+/// it holds `online_after` (a few seconds of an arc say little about a circle: Burg on them
+/// forecasts worse than the offline coefficients); forecasts apply eq. 27 recursively, feeding
+/// each prediction back.
 struct BurgParams {
   int order = 12;
   int window = 480;
   bool remove_mean = true;
   std::vector<double> initial_coefficients;  ///< a_1 .. a_p trained offline (may be empty)
+  int online_after = 240;  ///< samples before online estimates replace initial_coefficients
 };
 std::unique_ptr<AxisModel> make_burg_axis(const BurgParams& params);
 

@@ -59,6 +59,7 @@ PredictorParams load_params(const sg::Config& c) {
   p.burg.order = c.get<int>("predictor.order", p.burg.order);
   p.burg.window = c.get<int>("predictor.window", p.burg.window);
   p.burg.remove_mean = c.get<bool>("predictor.remove_mean", p.burg.remove_mean);
+  p.burg.online_after = c.get<int>("predictor.online_after", p.burg.online_after);
   p.kalman.q = c.get<double>("predictor.kalman_q", p.kalman.q);
   p.kalman.r = c.get<double>("predictor.kalman_r", p.kalman.r);
   if (p.period_us <= 0) throw c.error_at("predictor.period", "must be positive");
@@ -66,6 +67,8 @@ PredictorParams load_params(const sg::Config& c) {
   if (p.burg.order < 1) throw c.error_at("predictor.order", "must be at least 1");
   if (p.burg.window < p.burg.order + 3)
     throw c.error_at("predictor.window", "must exceed the order by 3");
+  if (p.burg.online_after < 0 || p.burg.online_after > p.burg.window)
+    throw c.error_at("predictor.online_after", "must be 0 to the window's length");
   return p;
 }
 

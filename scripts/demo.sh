@@ -1,32 +1,37 @@
 #!/usr/bin/env bash
-# The most complete loop that runs on this machine without hardware, recorded by lcm-logger.
+# The whole loop in simulation, recorded by lcm-logger: the paper's scenario ends with the ball
+# held and lifted.
 #
-#   scripts/demo.sh [--seconds N] [--tag NAME] [--with-images]
+#   scripts/demo.sh [--track-seconds N] [--tag NAME] [--with-images] [--no-prediction]
 #
-# Today: a one-second check that every stereograsp message type crosses the LCM bus intact
-# (sg-bus-check); then the simulated stereo cameras (sg-camera-sim) film the red ball on the
-# paper's path -- a 0.15 m circle at 1 rpm plus a drift along Y, hidden by a passing panel for two
-# seconds -- at 30 Hz; sg-vision finds the ball in both images and triangulates it with the
-# cameras' calibration (BLOB_LEFT, BLOB_RIGHT, OBJECT_POSITION); sg-predictor forecasts its path
-# 16 samples (4 s) ahead with Burg's linear predictors, carrying it through the occlusion
-# (OBJECT_TRAJECTORY); sg-viewer records the paper's user interface, the prediction drawn in, to a
-# video. The stock lcm-logger records the session into logs/ (camera images only with
-# --with-images: they are large). The arm and grasping join as they land.
+# 1. A one-second check that every stereograsp message type crosses the LCM bus intact.
+# 2. The cameras' calibration (the simulator's own) and the predictor's starting coefficients,
+#    trained offline on the paper's circle (sg-predictor train).
+# 3. The loop: sg-c550-sim plays the C550 on a pseudo-terminal (0.72-0.84 s per interaction),
+#    sg-arm-driver drives it, sg-camera-sim films the red ball on the paper's path (a 0.15 m
+#    circle at 1 rpm plus a drift along Y) and draws the gripper, sg-vision triangulates the ball,
+#    sg-predictor forecasts it 4 s ahead, sg-grasp tracks it with the arm at a stand-off
+#    (sg-grasp-ctl track), then grasps and lifts it (sg-grasp-ctl grasp), aiming where the ball
+#    will be when the slow controller gets there; sg-viewer records the user interface.
+# 4. The outcome, and what the log holds. The stock lcm-logger records the session into logs/
+#    (camera images only with --with-images: they are large).
 #
 # The bus is LCM's default (or $LCM_DEFAULT_URL), so `scripts/spy.sh` in another terminal shows
 # the channels while the demo runs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-seconds=${DEMO_SECONDS:-10}
+track_seconds=${DEMO_TRACK_SECONDS:-15}
 tag=demo
 with_images=0
+prediction=()
 while [ $# -gt 0 ]; do
   case "$1" in
-    --seconds) seconds="$2"; shift ;;
+    --track-seconds) track_seconds="$2"; shift ;;
     --tag) tag="$2"; shift ;;
     --with-images) with_images=1 ;;
-    -h|--help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --no-prediction) prediction=(--no-prediction) ;;
+    -h|--help) sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "demo.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
   shift
@@ -35,7 +40,7 @@ done
 scripts/bootstrap.sh
 if ! scripts/multicast.sh setup; then
   echo "demo: no multicast here; running the demo in a private network namespace" >&2
-  args=(--seconds "$seconds" --tag "$tag")
+  args=(--track-seconds "$track_seconds" --tag "$tag" "${prediction[@]}")
   [ "$with_images" -eq 1 ] && args+=(--with-images)
   exec scripts/multicast.sh run "$0" "${args[@]}"
 fi
@@ -71,34 +76,56 @@ wait "$receiver_pid" || status=1
 echo "   $(cat "$session.bus.txt")"
 rm -f "$session.bus.txt"
 
-frames=$(( seconds * 30 ))
-echo "demo: 2. the cameras' calibration (the simulator's own: robot-guided calibration comes later)"
+echo "demo: 2. the cameras' calibration (the simulator's own) and the predictor's coefficients"
 "$bin/sg-camera-sim" --snapshot "$session.pair.png" --snapshot-frame 60 \
   --calibration-out "$session.calibration.yaml" --log-level warn | sed 's/^/   /'
+# Four minutes of the paper's circle at 4 Hz, t,x,y,z: what Burg's predictors start from.
+awk 'BEGIN { pi = atan2(0, -1); for (k = 0; k < 960; k++) { t = k * 0.25; a = 2 * pi * t / 60;
+  printf "%.2f,%.6f,%.6f,0.10\n", t, 0.45 + 0.15 * cos(a), 0.15 * sin(a) } }' > "$session.circle.csv"
+"$bin/sg-predictor" train "$session.circle.csv" --out "$session.coefficients.yaml" | sed 's/^/   /'
+rm -f "$session.circle.csv"
 
-echo "demo: 3. cameras -> vision -> predictor -> viewer: the paper's motion at 30 Hz for $seconds s, occluded from 4 to 6 s"
+echo "demo: 3. the loop: C550 on a pseudo-terminal, driver, cameras, vision, predictor, grasp"
+"$bin/sg-c550-sim" --link "$session.c550" --log-commands "$session.c550.tsv" --log-level warn \
+  "${url_args[@]}" > "$session.c550.txt" 2>&1 &
+pids+=($!)
+for _ in $(seq 50); do [ -e "$session.c550" ] && break; sleep 0.1; done
+"$bin/sg-arm-driver" --device "$session.c550" --log-level warn "${url_args[@]}" \
+  > "$session.driver.txt" 2>&1 &
+pids+=($!)
 "$bin/sg-vision" --calibration "$session.calibration.yaml" --log-level warn "${url_args[@]}" \
   > "$session.vision.txt" &
-vision_pid=$!
-"$bin/sg-predictor" --log-level warn "${url_args[@]}" > "$session.predictor.txt" &
-predictor_pid=$!
+pids+=($!)
+"$bin/sg-predictor" --coefficients "$session.coefficients.yaml" --log-level warn \
+  "${url_args[@]}" > "$session.predictor.txt" &
+pids+=($!)
+"$bin/sg-grasp" "${prediction[@]}" "${url_args[@]}" > "$session.grasp.txt" 2>&1 &
+pids+=($!)
 "$bin/sg-viewer" --record "$session.view.avi" --no-window --calibration "$session.calibration.yaml" \
   --log-level warn "${url_args[@]}" > "$session.viewer.txt" &
 viewer_pid=$!
-pids+=("$vision_pid" "$predictor_pid" "$viewer_pid")
+pids+=("$viewer_pid")
 sleep 1
-"$bin/sg-camera-sim" --frames "$frames" --occlusion 4:2 --log-level warn "${url_args[@]}" \
-  | sed 's/^/   sg-camera-sim: /' || status=1
-sleep 1
-kill -INT "$vision_pid" "$predictor_pid" "$viewer_pid"
-wait "$vision_pid" || status=1
-wait "$predictor_pid" || status=1
-wait "$viewer_pid" || status=1
+"$bin/sg-camera-sim" --log-level warn "${url_args[@]}" > "$session.cameras.txt" &
+cameras_pid=$!
+pids+=("$cameras_pid")
+sleep 3
+echo "   sg-grasp-ctl track: the arm follows the ball at a stand-off for $track_seconds s"
+"$bin/sg-grasp-ctl" track "${url_args[@]}" | sed 's/^/   /' || status=1
+sleep "$track_seconds"
+echo "   sg-grasp-ctl grasp --wait: approach (q1), grasp (q2), hand closed (q3), lifted (q4)"
+outcome=0
+"$bin/sg-grasp-ctl" grasp --wait --timeout 60 "${url_args[@]}" | sed 's/^/   /' || outcome=$?
+[ "${PIPESTATUS[0]}" -eq 0 ] || outcome=1
+sleep 2
+kill -INT "$viewer_pid" 2>/dev/null || true
+wait "$viewer_pid" || true
+for p in "${pids[@]}"; do [ "$p" = "$logger_pid" ] || kill -INT "$p" 2>/dev/null || true; done
+for p in "${pids[@]}"; do [ "$p" = "$logger_pid" ] || wait "$p" 2>/dev/null || true; done
 pids=("$logger_pid")
-echo "   sg-vision: $(cat "$session.vision.txt")"
-echo "   sg-predictor: $(cat "$session.predictor.txt")"
-echo "   sg-viewer: $(cat "$session.viewer.txt")"
-rm -f "$session.vision.txt" "$session.predictor.txt" "$session.viewer.txt"
+echo "   sg-grasp: $(grep -c . "$session.grasp.txt") state changes (log: $session.grasp.txt)"
+echo "   sg-c550-sim: $(grep -c . "$session.c550.tsv") RAPL-II commands (log: $session.c550.tsv)"
+rm -f "$session.vision.txt" "$session.predictor.txt" "$session.viewer.txt" "$session.cameras.txt"
 
 sleep 0.5
 kill -INT "$logger_pid"
@@ -111,10 +138,15 @@ if [ "$status" -ne 0 ]; then
   echo "demo: FAILED (log kept: $log)" >&2
   exit 1
 fi
+if [ "$outcome" -ne 0 ]; then
+  echo "demo: the grasp FAILED (see $session.grasp.txt; log: $log)" >&2
+  exit 1
+fi
 cat <<MSG
-demo: done. The session log is $log
+demo: done: the ball was grasped and lifted. The session log is $log
   the cameras' true calibration: $session.calibration.yaml
   a stereo pair as the cameras saw it: $session.pair.png
+  the grasp state machine's log: $session.grasp.txt; the controller's commands: $session.c550.tsv
   the user interface, recorded: $session.view.avi (frame-to-utime: $session.view.avi.csv)
   replay it:   lcm-logplayer $log
   inspect it:  scripts/spy.sh (while replaying or during a demo)

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <set>
 #include <stdexcept>
 #include <utility>
@@ -427,6 +428,18 @@ C550Emulator::Answer C550Emulator::open(const std::string& rest, double t) {
 C550Emulator::Answer C550Emulator::close(const std::string& rest, double t) {
   grip_argument(rest);
   controller_.close(t, ball_);
+  const Eigen::Vector3d tcp = controller_.tool_pose(t).translation();
+  char text[160];
+  if (ball_) {
+    std::snprintf(text, sizeof text,
+                  "CLOSE at (%.3f, %.3f, %.3f): the ball's centre %.1f mm away: %s", tcp.x(),
+                  tcp.y(), tcp.z(), (tcp - *ball_).norm() * 1e3,
+                  controller_.holding() ? "held" : "not held");
+  } else {
+    std::snprintf(text, sizeof text, "CLOSE at (%.3f, %.3f, %.3f): no ball known", tcp.x(), tcp.y(),
+                  tcp.z());
+  }
+  event(text);
   return motion({}, t);
 }
 

@@ -121,6 +121,29 @@ TEST(Burg, ConstantSignalIsFinite) {
   }
 }
 
+// Offline-trained coefficients are kept until the window holds online_after samples, then Burg's
+// own estimate replaces them: a wrong AR(2) forecast (a_1 = 2, a_2 = -1: a straight line) shows
+// which coefficients are in use on a noise-free sinusoid.
+TEST(Burg, OfflineCoefficientsHoldUntilOnlineAfter) {
+  BurgParams p;
+  p.order = 2;
+  p.remove_mean = false;
+  p.initial_coefficients = {-2.0, 1.0};  // eq. 27's sign: x[n] = -a_1 x[n-1] - a_2 x[n-2]
+  p.online_after = 40;
+  auto axis = make_burg_axis(p);
+  const double w = 2 * M_PI / 24;
+  auto wave = [w](int n) { return std::sin(w * n); };
+  for (int n = 0; n < 39; ++n) axis->push(wave(n), true);
+  // Still the straight line through the last two samples.
+  EXPECT_NEAR(axis->forecast(1)[0], 2 * wave(38) - wave(37), 1e-12);
+  axis->push(wave(39), true);
+  // Burg on a pure sinusoid finds about x[n] = 2 cos(w) x[n-1] - x[n-2]: far nearer the next
+  // sample than the straight line (whose error is about w^2 |x|, 0.05 here).
+  const double line_error = std::abs(2 * wave(39) - wave(38) - wave(40));
+  EXPECT_GT(line_error, 0.04);
+  EXPECT_LT(std::abs(axis->forecast(1)[0] - wave(40)), 0.2 * line_error);
+}
+
 PredictorParams params_4hz() {
   PredictorParams p;
   p.burg.window = 240;

@@ -1,0 +1,557 @@
+#include "arm_driver/grasp_machine.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <utility>
+
+#include "stereograsp/arm_cmd_t.hpp"
+
+namespace sg::arm {
+namespace {
+
+using Cmd = stereograsp::arm_cmd_t;
+
+/// Microseconds in `seconds`, rounded to the nearest.
+int64_t to_us(double seconds) { return std::llround(seconds * 1e6); }
+
+/// `value` with `digits` decimals.
+std::string fixed(double value, int digits) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*f", digits, value);
+  return buffer;
+}
+
+/// How many commands of a request the controller digests for one delay each (MA, READY, OPEN,
+/// CLOSE; ABORT is not one).
+int motion_commands(int8_t mode, int8_t gripper) {
+  const int motion = (mode == Cmd::MODE_CARTESIAN || mode == Cmd::MODE_HOME) ? 1 : 0;
+  return motion + (gripper != Cmd::GRIPPER_KEEP ? 1 : 0);
+}
+
+/// Sequence numbers kept for the delay learning (an answer comes within a couple of requests).
+constexpr std::size_t kRememberedRequests = 16;
+
+}  // namespace
+
+const char* to_string(GraspState state) {
+  switch (state) {
+    case GraspState::kHandOpened:
+      return "q0 hand opened";
+    case GraspState::kApproaching:
+      return "q1 approaching";
+    case GraspState::kGrasping:
+      return "q2 grasping";
+    case GraspState::kHandClosed:
+      return "q3 hand closed";
+    case GraspState::kObjectLifted:
+      return "q4 object lifted";
+  }
+  return "unknown";
+}
+
+const char* to_string(GraspActivity activity) {
+  switch (activity) {
+    case GraspActivity::kIdle:
+      return "idle";
+    case GraspActivity::kTracking:
+      return "tracking";
+    case GraspActivity::kGrasping:
+      return "grasping";
+    case GraspActivity::kHoming:
+      return "homing";
+    case GraspActivity::kBackingOff:
+      return "backing off";
+  }
+  return "unknown";
+}
+
+const char* to_string(GraspAction action) {
+  switch (action) {
+    case GraspAction::kNone:
+      return "none";
+    case GraspAction::kOpenHand:
+      return "a0 open hand";
+    case GraspAction::kApproachObject:
+      return "a1 approach object";
+    case GraspAction::kCloseHand:
+      return "a2 close hand";
+    case GraspAction::kLiftObject:
+      return "a3 lift object";
+  }
+  return "unknown";
+}
+
+const char* to_string(GraspOutcome outcome) {
+  switch (outcome) {
+    case GraspOutcome::kNone:
+      return "none";
+    case GraspOutcome::kSuccess:
+      return "success";
+    case GraspOutcome::kFailed:
+      return "failed";
+    case GraspOutcome::kAborted:
+      return "aborted";
+  }
+  return "unknown";
+}
+
+const char* to_string(GraspCommand command) {
+  switch (command) {
+    case GraspCommand::kTrack:
+      return "track";
+    case GraspCommand::kGrasp:
+      return "grasp";
+    case GraspCommand::kRelease:
+      return "release";
+    case GraspCommand::kAbort:
+      return "abort";
+    case GraspCommand::kHome:
+      return "home";
+  }
+  return "unknown";
+}
+
+GraspMachine::GraspMachine(ArmGeometry geometry, GraspSettings settings, int64_t first_sequence)
+    : geometry_(std::move(geometry)),
+      settings_(std::move(settings)),
+      next_sequence_(first_sequence),
+      delay_(settings_.default_delay) {}
+
+// ---------------------------------------------------------------------------------------------
+// Inputs.
+
+void GraspMachine::on_command(GraspCommand command, double standoff, int64_t now) {
+  update(now);
+  const GraspState state = status_.state;
+  const GraspActivity activity = status_.activity;
+  const std::string where =
+      std::string(" in ") + to_string(state) + " (" + to_string(activity) + ")";
+  switch (command) {
+    case GraspCommand::kTrack: {
+      if (state != GraspState::kHandOpened || activity == GraspActivity::kGrasping ||
+          activity == GraspActivity::kBackingOff) {
+        refuse("track refused" + where +
+               (state == GraspState::kHandOpened ? "" : ": release the object first"));
+        return;
+      }
+      if (standoff != 0) {
+        if (!(std::isfinite(standoff) && standoff > 0)) {
+          refuse("track: stand-off " + fixed(standoff, 3) + " m refused (must be > 0); kept " +
+                 fixed(settings_.standoff, 3) + " m");
+          return;
+        }
+        settings_.standoff = standoff;
+      }
+      status_.activity = GraspActivity::kTracking;
+      home_pending_ = false;
+      set_message("");
+      return;
+    }
+    case GraspCommand::kGrasp: {
+      if (state != GraspState::kHandOpened || activity == GraspActivity::kGrasping ||
+          activity == GraspActivity::kBackingOff) {
+        refuse("grasp refused" + where);
+        return;
+      }
+      if (!track_fresh(now)) {
+        refuse("grasp refused: no fresh track of the object");
+        return;
+      }
+      status_.state = GraspState::kApproaching;
+      status_.activity = GraspActivity::kGrasping;
+      status_.last_action = GraspAction::kApproachObject;
+      status_.outcome = GraspOutcome::kNone;
+      home_pending_ = false;
+      set_message("");
+      return;
+    }
+    case GraspCommand::kRelease: {
+      if (state != GraspState::kHandClosed && state != GraspState::kObjectLifted) {
+        refuse("release ignored" + where + ": the hand holds nothing");
+        return;
+      }
+      if (grasp_in_progress()) abort_grasp("released" + where);
+      status_.activity = GraspActivity::kIdle;
+      lift_pending_ = false;
+      home_pending_ = false;
+      judging_ = false;
+      open_pending_ = true;
+      return;
+    }
+    case GraspCommand::kAbort: {
+      if (grasp_in_progress()) abort_grasp("aborted" + where);
+      status_.state = GraspState::kHandOpened;
+      status_.activity = GraspActivity::kIdle;
+      open_pending_ = false;  // the STOP opens the hand
+      home_pending_ = false;
+      lift_pending_ = false;
+      backoff_pending_ = false;
+      judging_ = false;
+      stop_pending_ = true;
+      return;
+    }
+    case GraspCommand::kHome: {
+      if (activity == GraspActivity::kGrasping || activity == GraspActivity::kBackingOff) {
+        refuse("home refused" + where + ": abort first");
+        return;
+      }
+      const bool home_on_its_way = home_pending_ || (in_flight_ && in_flight_->kind == Kind::kHome);
+      if (activity == GraspActivity::kHoming && home_on_its_way) return;
+      status_.activity = GraspActivity::kHoming;
+      home_pending_ = true;
+      set_message("");
+      return;
+    }
+  }
+  refuse("unknown command " + std::to_string(static_cast<int>(command)));
+}
+
+void GraspMachine::on_trajectory(const PredictedPath& path, int64_t source_utime, int64_t now) {
+  if (settings_.use_prediction) {
+    path_ = path;
+    path_source_utime_ = source_utime;
+  }
+  update(now);
+}
+
+void GraspMachine::on_measurement(const std::optional<Eigen::Vector3d>& position, int64_t utime) {
+  if (position && position->allFinite() && utime >= measured_utime_) {
+    measured_ = *position;
+    measured_utime_ = utime;
+  }
+  judge(utime);
+}
+
+void GraspMachine::on_arm_status(const ArmView& arm, int64_t now) {
+  arm_ = arm;
+  have_arm_ = true;
+
+  // The delay: the driver publishes a new interaction_time once the interaction of its
+  // last_executed_sequence is complete.
+  if (arm.interaction_time != seen_interaction_time_) {
+    seen_interaction_time_ = arm.interaction_time;
+    const auto it = motion_commands_.find(arm.last_executed_sequence);
+    if (it != motion_commands_.end()) {
+      const double sample = arm.interaction_time / std::max(it->second, 1);
+      if (it->second > 0 && std::isfinite(sample) && sample > 0 && sample < 10) {
+        delay_ = (1 - kDelayWeight) * delay_ + kDelayWeight * sample;
+      }
+      motion_commands_.erase(it);
+    }
+  }
+
+  if (in_flight_) {
+    const int64_t sequence = in_flight_->sequence;
+    if (arm.last_rejected_sequence == sequence) {
+      answered(true, "rejected", now);
+    } else if (arm.last_executed_sequence == sequence) {
+      answered(false, "", now);
+    }
+  }
+  if (judging_ && !stopped_utime_ && !in_flight_ && !arm.moving) stopped_utime_ = now;
+  update(now);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Requests.
+
+std::optional<ArmRequest> GraspMachine::take_request(int64_t now) {
+  update(now);
+  if (!have_arm_ || !arm_.connected) return std::nullopt;
+
+  if (stop_pending_) {  // abort: at once, even with a request in flight
+    stop_pending_ = false;
+    ArmRequest r = make(Kind::kStop, Cmd::MODE_STOP, Cmd::GRIPPER_OPEN, now);
+    status_.last_action = GraspAction::kOpenHand;
+    status_.target.reset();
+    status_.target_utime = 0;
+    status_.source_utime = 0;
+    return r;
+  }
+  if (in_flight_) return std::nullopt;
+
+  if (open_pending_) {
+    open_pending_ = false;
+    ArmRequest r = make(Kind::kOpenHand, Cmd::MODE_GRIPPER_ONLY, Cmd::GRIPPER_OPEN, now);
+    status_.last_action = GraspAction::kOpenHand;
+    status_.state = GraspState::kHandOpened;
+    return r;
+  }
+
+  const GraspActivity activity = status_.activity;
+  const GraspState state = status_.state;
+  if (activity == GraspActivity::kHoming && home_pending_) {
+    home_pending_ = false;
+    ArmRequest r = make(Kind::kHome, Cmd::MODE_HOME, Cmd::GRIPPER_KEEP, now);
+    status_.target.reset();
+    status_.target_utime = 0;
+    status_.source_utime = 0;
+    return r;
+  }
+  if (activity == GraspActivity::kBackingOff && backoff_pending_) {
+    backoff_pending_ = false;
+    Eigen::Vector3d up = arm_.tool + Eigen::Vector3d(0, 0, settings_.backoff);
+    up.z() = std::min(up.z(), geometry_.workspace.max.z());
+    const std::string problem = check_target(up);
+    if (!problem.empty()) {
+      status_.activity = GraspActivity::kIdle;
+      set_message("track lost; back-off refused: " + problem);
+      return std::nullopt;
+    }
+    const Eigen::Vector3d rpy =
+        rpy_from_rotation(forward_kinematics(geometry_, arm_.joints).rotation());
+    return cartesian(Kind::kBackoff, up, rpy, Cmd::GRIPPER_KEEP, now);
+  }
+  if (activity == GraspActivity::kGrasping && state == GraspState::kHandClosed && lift_pending_) {
+    lift_pending_ = false;
+    Eigen::Vector3d up = approach_position_ + Eigen::Vector3d(0, 0, settings_.lift);
+    up.z() = std::min(up.z(), geometry_.workspace.max.z());
+    const std::string problem = check_target(up);
+    if (!problem.empty()) {
+      status_.activity = GraspActivity::kIdle;
+      status_.outcome = GraspOutcome::kFailed;
+      set_message("lift refused: " + problem);
+      return std::nullopt;
+    }
+    status_.last_action = GraspAction::kLiftObject;
+    return cartesian(Kind::kLift, up, approach_rpy_, Cmd::GRIPPER_KEEP, now);
+  }
+  if (activity == GraspActivity::kGrasping && state == GraspState::kApproaching) {
+    std::optional<ArmRequest> r = aim(Kind::kApproach, now);
+    if (r) {
+      status_.state = GraspState::kGrasping;
+      status_.last_action = GraspAction::kCloseHand;
+    }
+    return r;
+  }
+  if (activity == GraspActivity::kTracking && state == GraspState::kHandOpened) {
+    return aim(Kind::kTrack, now);
+  }
+  return std::nullopt;
+}
+
+std::optional<ArmRequest> GraspMachine::aim(Kind kind, int64_t now) {
+  int64_t source_utime = 0;
+  const std::optional<PredictedPath> path = fresh_path(now, &source_utime);
+  if (!path) {
+    refuse("no fresh track of the object");
+    return std::nullopt;
+  }
+  const bool approach = kind == Kind::kApproach;
+  const Eigen::Vector3d offset(0, 0, approach ? 0.0 : settings_.standoff);
+  const Interception aim =
+      intercept(geometry_, *path, arm_.joints, now, delay_, approach ? delay_ : 0.0, offset,
+                settings_.speed, settings_.interception);
+  if (!aim.ok) {
+    refuse("target refused: " + aim.error);
+    return std::nullopt;
+  }
+  const std::string problem = check_target(aim.pose.position);
+  if (!problem.empty()) {
+    refuse("target refused: " + problem);
+    return std::nullopt;
+  }
+  std::optional<ArmRequest> r = cartesian(kind, aim.pose.position, aim.pose.rpy,
+                                          approach ? Cmd::GRIPPER_CLOSE : Cmd::GRIPPER_KEEP, now);
+  r->source_utime = source_utime;
+  r->target_utime = aim.arrival_utime;
+  status_.target_utime = aim.arrival_utime;
+  status_.source_utime = source_utime;
+  if (approach) {
+    approach_position_ = aim.pose.position;
+    approach_rpy_ = aim.pose.rpy;
+  }
+  return r;
+}
+
+std::optional<ArmRequest> GraspMachine::cartesian(Kind kind, const Eigen::Vector3d& position,
+                                                  const Eigen::Vector3d& rpy, int8_t gripper,
+                                                  int64_t now) {
+  ArmRequest r = make(kind, Cmd::MODE_CARTESIAN, gripper, now);
+  r.position = position;
+  r.rpy = rpy;
+  status_.target = position;
+  status_.target_utime = 0;
+  status_.source_utime = 0;
+  return r;
+}
+
+ArmRequest GraspMachine::make(Kind kind, int8_t mode, int8_t gripper, int64_t now) {
+  ArmRequest r;
+  r.sequence = next_sequence_++;
+  r.mode = mode;
+  r.gripper = gripper;
+  r.speed = settings_.speed;
+  in_flight_ = InFlight{r.sequence, kind, now};
+  motion_commands_[r.sequence] = motion_commands(mode, gripper);
+  while (motion_commands_.size() > kRememberedRequests) {
+    motion_commands_.erase(motion_commands_.begin());
+  }
+  if (message_is_refusal_) set_message("");
+  return r;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Answers, time and the track.
+
+void GraspMachine::answered(bool failed, const std::string& how, int64_t now) {
+  const InFlight done = *in_flight_;
+  in_flight_.reset();
+  const std::string request = " (request " + std::to_string(done.sequence) + ")";
+  const std::string failure = "the arm " + how + " ";
+  switch (done.kind) {
+    case Kind::kOpenHand:
+      if (failed) {
+        open_pending_ = true;
+        refuse(failure + "a0 open hand" + request);
+      }
+      return;
+    case Kind::kStop:
+      if (failed) {
+        stop_pending_ = true;
+        refuse(failure + "the stop" + request);
+      }
+      return;
+    case Kind::kHome:
+      if (status_.activity == GraspActivity::kHoming && !home_pending_) {
+        status_.activity = GraspActivity::kIdle;
+      }
+      if (failed) set_message(failure + "home" + request);
+      return;
+    case Kind::kTrack:
+      if (failed) refuse(failure + "the tracking target" + request);
+      return;
+    case Kind::kApproach:
+      if (status_.state != GraspState::kGrasping || status_.activity != GraspActivity::kGrasping) {
+        return;
+      }
+      if (failed) {
+        status_.state = GraspState::kApproaching;
+        status_.last_action = GraspAction::kApproachObject;
+        refuse(failure + "the approach" + request + "; trying again");
+      } else {
+        status_.state = GraspState::kHandClosed;
+        lift_pending_ = true;
+      }
+      return;
+    case Kind::kLift:
+      if (status_.state != GraspState::kHandClosed ||
+          status_.activity != GraspActivity::kGrasping) {
+        return;
+      }
+      if (failed) {
+        status_.activity = GraspActivity::kIdle;
+        status_.outcome = GraspOutcome::kFailed;
+        set_message(failure + "the lift" + request);
+      } else {
+        status_.state = GraspState::kObjectLifted;
+        judging_ = true;
+        lifted_utime_ = now;
+        stopped_utime_.reset();
+      }
+      return;
+    case Kind::kBackoff:
+      if (status_.activity == GraspActivity::kBackingOff) {
+        status_.activity = GraspActivity::kIdle;
+        if (failed) set_message("track lost; " + failure + "the back-off" + request);
+      }
+      return;
+  }
+}
+
+void GraspMachine::update(int64_t now) {
+  if (in_flight_) {
+    const double limit = std::max(kAnswerTimeout, 8 * delay_);
+    if (now - in_flight_->sent_utime > to_us(limit)) answered(true, "did not answer", now);
+  }
+  if (status_.state == GraspState::kApproaching && status_.activity == GraspActivity::kGrasping &&
+      !track_fresh(now)) {
+    status_.state = GraspState::kHandOpened;
+    status_.activity = GraspActivity::kBackingOff;
+    status_.outcome = GraspOutcome::kFailed;
+    set_message("track lost");
+    backoff_pending_ = true;
+  }
+  judge(now);
+}
+
+void GraspMachine::judge(int64_t now) {
+  if (!judging_) return;
+  // From when a measurement says where the ball is with the arm at rest.
+  const int64_t rest = stopped_utime_ ? *stopped_utime_ : lifted_utime_ + to_us(kSettleTimeout);
+  if (now < rest) return;
+  if (measured_ && measured_utime_ >= rest) {
+    const double distance = (*measured_ - arm_.tool).norm();
+    const bool held = distance <= settings_.success_distance;
+    status_.outcome = held ? GraspOutcome::kSuccess : GraspOutcome::kFailed;
+    set_message(std::string(held ? "object held" : "object not held") + ": ball " +
+                fixed(distance, 3) + " m from the tool (limit " +
+                fixed(settings_.success_distance, 3) + " m)");
+  } else if (now > rest + to_us(settings_.max_trajectory_age)) {
+    status_.outcome = GraspOutcome::kFailed;
+    set_message("ball not seen after the lift");
+  } else {
+    return;
+  }
+  judging_ = false;
+  status_.activity = GraspActivity::kIdle;
+}
+
+bool GraspMachine::track_fresh(int64_t now) const {
+  int64_t source_utime = 0;
+  return fresh_path(now, &source_utime).has_value();
+}
+
+std::optional<PredictedPath> GraspMachine::fresh_path(int64_t now, int64_t* source_utime) const {
+  const int64_t oldest = now - to_us(settings_.max_trajectory_age);
+  if (settings_.use_prediction) {
+    if (!path_ || path_->lost || path_->points.empty() || path_->utime < oldest) {
+      return std::nullopt;
+    }
+    *source_utime = path_source_utime_;
+    return path_;
+  }
+  if (!measured_ || measured_utime_ < oldest) return std::nullopt;
+  *source_utime = measured_utime_;
+  return PredictedPath::hold(*measured_, measured_utime_);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Small helpers.
+
+std::string GraspMachine::check_target(const Eigen::Vector3d& target) const {
+  if (!target.allFinite()) return "target is not finite";
+  const double floor = settings_.interception.table_z + settings_.interception.table_margin;
+  if (!(target.z() >= floor)) {
+    return "target below the table plus margin (z = " + fixed(target.z(), 3) + " m < " +
+           fixed(floor, 3) + " m)";
+  }
+  if (!geometry_.workspace.contains(target)) {
+    return "target outside the workspace (" + fixed(target.x(), 3) + ", " + fixed(target.y(), 3) +
+           ", " + fixed(target.z(), 3) + ") m";
+  }
+  return "";
+}
+
+bool GraspMachine::grasp_in_progress() const {
+  return status_.activity == GraspActivity::kGrasping;
+}
+
+void GraspMachine::abort_grasp(const std::string& why) {
+  status_.outcome = GraspOutcome::kAborted;
+  set_message(why);
+}
+
+void GraspMachine::refuse(std::string message) {
+  status_.message = std::move(message);
+  message_is_refusal_ = true;
+}
+
+void GraspMachine::set_message(std::string message) {
+  status_.message = std::move(message);
+  message_is_refusal_ = false;
+}
+
+}  // namespace sg::arm

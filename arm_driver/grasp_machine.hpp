@@ -1,0 +1,294 @@
+#pragma once
+
+/// The grasp state machine of the paper's section 6 (figure 4): states q0 hand opened,
+/// q1 approaching, q2 grasping, q3 hand closed, q4 object lifted; actions a0 open hand,
+/// a1 approach object, a2 close hand, a3 lift object. Before a grasp is asked for, the arm
+/// tracks the ball: it follows the predicted position at a stand-off distance above it.
+///
+/// The machine is pure: no clock and no bus. A shell (sg-grasp) turns GRASP_COMMAND,
+/// OBJECT_TRAJECTORY, OBJECT_POSITION and ARM_STATUS into the on_*() calls, asks take_request()
+/// for the next ARM_COMMAND after each of them, and publishes status() on GRASP_STATUS. Times are
+/// microseconds since the Unix epoch, lengths metres, in the robot base frame.
+///
+/// One request in flight. The C550 answers one interaction every 0.72-0.84 s and the driver
+/// keeps only the latest command, so the machine sends a new request only after ARM_STATUS
+/// reported the previous one executed (last_executed_sequence) or rejected
+/// (last_rejected_sequence): each target is computed just before the controller can act on it,
+/// from the newest prediction. The one exception is abort, which is sent at once (the driver's
+/// latest-wins slot makes the STOP the next thing on the line). A request with no answer for
+/// kAnswerTimeout (or 8 delays, whichever is longer) is given up and treated as rejected.
+///
+/// Interception. A Cartesian target aims where the ball will be when the gripper gets there:
+/// intercept() (interception.hpp) with lead = delay_estimate(). Tracking uses the offset
+/// (0, 0, standoff) and after_start = 0; the approach (a1) uses offset 0 and after_start = one
+/// delay, because its GRIPPER_CLOSE (a2) travels in the same arm_cmd_t and the controller
+/// executes the CLOSE one delay after the motion starts. A target is refused (no request, a
+/// message in status()) when intercept() fails or the target is below table_z + table_margin or
+/// outside the workspace box; the machine stays where it is and tries again on the next
+/// take_request().
+///
+/// Transitions: the state and activity after the command and the request it makes (sent by
+/// take_request()); a refused or ignored command changes nothing but status().message.
+///
+/// | state activity        | track       | grasp*      | release       | abort         | home     |
+/// |-----------------------|-------------|-------------|---------------|---------------|----------|
+/// | q0 idle               | q0 tracking | q1 grasping | ignored       | q0 idle STOP  | homing H |
+/// | q0 tracking           | q0 tracking | q1 grasping | ignored       | q0 idle STOP  | homing H |
+/// | q0 homing             | q0 tracking | q1 grasping | ignored       | q0 idle STOP  | homing   |
+/// | q0 backing off        | refused     | refused     | ignored       | q0 idle STOP  | refused  |
+/// | q1 grasping (a1 next) | refused     | refused     | ignored       | q0 idle STOP! | refused  |
+/// | q2 grasping (a2 sent) | refused     | refused     | ignored       | q0 idle STOP! | refused  |
+/// | q3 grasping (a3 next) | refused     | refused     | q0 idle OPEN! | q0 idle STOP! | refused  |
+/// | q3 idle               | refused     | refused     | q0 idle OPEN  | q0 idle STOP  | homing H |
+/// | q4 grasping (judging) | refused     | refused     | q0 idle OPEN! | q0 idle STOP! | refused  |
+/// | q4 idle               | refused     | refused     | q0 idle OPEN  | q0 idle STOP  | homing H |
+///
+/// grasp*: with a fresh track, otherwise refused. STOP: MODE_STOP + GRIPPER_OPEN; OPEN (a0):
+/// MODE_GRIPPER_ONLY + GRIPPER_OPEN, the state turns q0 when it is sent; H: MODE_HOME +
+/// GRIPPER_KEEP, the state unchanged. "!": the grasp in progress ends with outcome kAborted. A
+/// fresh track is a trajectory that is not lost and not older than max_trajectory_age. Homing ends
+/// (activity idle) when HOME is executed.
+///
+/// The grasp, driven by the arm's answers:
+///  - q1 (a1): each take_request() intercepts; the request is MODE_CARTESIAN + GRIPPER_CLOSE and
+///    when it is sent the state is q2 (a2, the close, is in flight). Rejected by the arm: back
+///    to q1, which tries again.
+///  - q2 -> q3 when the arm reports it executed; then a3: straight up by `lift` from the target,
+///    same orientation (z clamped to the workspace box).
+///  - q3 -> q4 when the lift is executed. The outcome is judged on the first measurement
+///    captured after the arm reported it had stopped (or kSettleTimeout after the lift, if it
+///    never does): success when the ball is within success_distance of the arm's tool, failed
+///    (the message gives the distance) otherwise, or failed "ball not seen after the lift" when
+///    no visible measurement comes within max_trajectory_age. Activity idle. (A measurement
+///    from before the lift says nothing: the ball sits at the tool whether it was grasped or
+///    not.)
+///  - Lost track in q1 (the trajectory is lost, or none newer than max_trajectory_age): the
+///    approach stops; state q0, activity backing off, outcome failed "track lost", and a move
+///    straight up by `backoff` from the current tool (orientation by forward kinematics of the
+///    current joints); idle when it is executed. In q2 and later the close is already on its way
+///    and the track is no longer needed. While tracking, a lost track only stops the requests
+///    until it returns.
+///  - A lift or back-off rejected by the arm ends the sequence (q3/idle failed, or q0/idle): the
+///    same target would be rejected again. A rejected tracking move, approach, open or stop is
+///    computed afresh and sent again.
+///
+/// The first request, once the arm is connected, is a0 (open hand). Requests are made only
+/// while ArmView.connected.
+///
+/// --no-prediction (use_prediction = false): the path is PredictedPath::hold(last visible
+/// measurement, its utime), its freshness that of the measurement; trajectories are ignored.
+///
+///     GraspMachine machine(ArmGeometry::a465(), GraspSettings{}, /*first_sequence=*/1);
+///     // on each message:                           (now = the shell's clock, us)
+///     machine.on_arm_status(view_of(arm_status), now);
+///     machine.on_trajectory(path_from(trajectory), trajectory.source_utime, now);
+///     machine.on_command(GraspCommand::kGrasp, 0.0, now);
+///     if (std::optional<ArmRequest> r = machine.take_request(now)) publish(to_arm_cmd(*r));
+///     publish(to_grasp_status(machine.status()));
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+
+#include "arm_driver/interception.hpp"
+#include "arm_driver/kinematics.hpp"
+
+namespace sg::arm {
+
+/// Figure 4's states (grasp_status_t Q*).
+enum class GraspState : int8_t {
+  kHandOpened = 0,
+  kApproaching = 1,
+  kGrasping = 2,
+  kHandClosed = 3,
+  kObjectLifted = 4
+};
+
+/// What the machine is doing (grasp_status_t ACTIVITY_*).
+enum class GraspActivity : int8_t {
+  kIdle = 0,
+  kTracking = 1,
+  kGrasping = 2,
+  kHoming = 3,
+  kBackingOff = 4
+};
+
+/// Figure 4's actions (grasp_status_t A*), the last one taken.
+enum class GraspAction : int8_t {
+  kNone = -1,
+  kOpenHand = 0,
+  kApproachObject = 1,
+  kCloseHand = 2,
+  kLiftObject = 3
+};
+
+/// The outcome of the last grasp (grasp_status_t OUTCOME_*).
+enum class GraspOutcome : int8_t { kNone = 0, kSuccess = 1, kFailed = 2, kAborted = 3 };
+
+/// An operator's request (grasp_command_t COMMAND_* values).
+enum class GraspCommand : int8_t { kTrack = 1, kGrasp = 2, kRelease = 3, kAbort = 4, kHome = 5 };
+
+/// "q0 hand opened" .. "q4 object lifted".
+const char* to_string(GraspState state);
+/// "idle", "tracking", "grasping", "homing", "backing off".
+const char* to_string(GraspActivity activity);
+/// "none", "a0 open hand", "a1 approach object", "a2 close hand", "a3 lift object".
+const char* to_string(GraspAction action);
+/// "none", "success", "failed", "aborted".
+const char* to_string(GraspOutcome outcome);
+/// "track", "grasp", "release", "abort", "home" ("unknown" for any other value).
+const char* to_string(GraspCommand command);
+
+/// What the machine needs of ARM_STATUS.
+struct ArmView {
+  bool connected = false;  ///< state != DISCONNECTED
+  bool moving = false;     ///< state == MOVING
+  bool error = false;      ///< state == ERROR (informational: refusals come as rejections)
+  int64_t last_executed_sequence = -1;
+  int64_t last_rejected_sequence = -1;
+  Joints joints = Joints::Zero();
+  Eigen::Vector3d tool = Eigen::Vector3d::Zero();  ///< tool centre point
+  double interaction_time = 0;                     ///< s, of the driver's last interaction
+};
+
+/// One arm_cmd_t to send (the same constants as stereograsp::arm_cmd_t).
+struct ArmRequest {
+  int64_t sequence = 0;
+  int8_t mode = 0;  ///< arm_cmd_t::MODE_CARTESIAN / MODE_GRIPPER_ONLY / MODE_HOME / MODE_STOP
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Vector3d rpy = Eigen::Vector3d::Zero();
+  int8_t gripper = 0;  ///< arm_cmd_t::GRIPPER_KEEP / OPEN / CLOSE
+  double speed = 0.5;
+  int64_t source_utime = 0;  ///< the trajectory's source_utime behind it
+  int64_t target_utime = 0;  ///< interception time T (0 when none)
+};
+
+struct GraspSettings {
+  double standoff = 0.10;           ///< m above the ball while tracking
+  double lift = 0.15;               ///< m the object is lifted (a3)
+  double backoff = 0.10;            ///< m the tool rises when the track is lost in an approach
+  double speed = 0.5;               ///< fraction of the joint speed limits (the paper's 50 %)
+  double max_trajectory_age = 1.0;  ///< s: a trajectory older than now - this gives no command
+  double success_distance = 0.05;   ///< m: after the lift, a ball this close to the tool = success
+  double default_delay = 0.78;      ///< s per controller command until one is measured
+  bool use_prediction = true;       ///< false: aim at the last measurement (PredictedPath::hold)
+  InterceptionSettings interception;
+};
+
+/// What GRASP_STATUS shows.
+struct GraspStatusView {
+  GraspState state = GraspState::kHandOpened;
+  GraspActivity activity = GraspActivity::kIdle;
+  GraspAction last_action = GraspAction::kNone;
+  GraspOutcome outcome = GraspOutcome::kNone;
+  std::optional<Eigen::Vector3d> target;  ///< current tool target (none after STOP or HOME)
+  int64_t target_utime = 0;
+  int64_t source_utime = 0;
+  std::string message;  ///< why a grasp failed, a target or a command was refused
+};
+
+/// The grasp state machine; see the file comment for its transitions.
+class GraspMachine {
+ public:
+  /// A request unanswered this long (or 8 delay estimates, if longer) is treated as rejected.
+  static constexpr double kAnswerTimeout = 5.0;  // s
+  /// After the lift, the outcome is judged even if the arm still reports moving after this.
+  static constexpr double kSettleTimeout = 3.0;  // s
+
+  /// `first_sequence`: the sequence number of the first request (then +1 per request).
+  GraspMachine(ArmGeometry geometry, GraspSettings settings, int64_t first_sequence);
+
+  /// An operator's command at `now`. `standoff` (m) applies to kTrack; 0 keeps the current one,
+  /// a negative or non-finite one refuses the command.
+  void on_command(GraspCommand command, double standoff, int64_t now);
+
+  /// A new OBJECT_TRAJECTORY (ignored when use_prediction is false).
+  void on_trajectory(const PredictedPath& path, int64_t source_utime, int64_t now);
+
+  /// A new OBJECT_POSITION captured at `utime`: nullopt when the ball was not visible.
+  void on_measurement(const std::optional<Eigen::Vector3d>& position, int64_t utime);
+
+  /// A new ARM_STATUS: frees the request slot, advances the grasp, learns the delay.
+  void on_arm_status(const ArmView& arm, int64_t now);
+
+  /// The next command for the arm, or nullopt. At most one request in flight: a new one only
+  /// after the arm reported the previous one executed (or rejected), so each is computed just
+  /// before the controller can act on it. Abort is the exception (sent at once). Sequence
+  /// numbers increase from first_sequence.
+  std::optional<ArmRequest> take_request(int64_t now);
+
+  const GraspStatusView& status() const { return status_; }
+
+  /// Seconds per controller command, learnt from ArmView.interaction_time (an exponential
+  /// average, weight kDelayWeight per interaction; an interaction that sent N motion commands
+  /// counts as N delays). default_delay until the first one is measured.
+  double delay_estimate() const { return delay_; }
+
+  /// Weight of a new measurement in delay_estimate().
+  static constexpr double kDelayWeight = 0.3;
+
+ private:
+  /// What a request in flight was for.
+  enum class Kind { kOpenHand, kStop, kHome, kTrack, kApproach, kLift, kBackoff };
+
+  struct InFlight {
+    int64_t sequence = 0;
+    Kind kind = Kind::kTrack;
+    int64_t sent_utime = 0;
+  };
+
+  /// The path to aim with at `now` (fresh, not lost), with its source_utime, or nullopt.
+  std::optional<PredictedPath> fresh_path(int64_t now, int64_t* source_utime) const;
+  bool track_fresh(int64_t now) const;
+  /// Starts the back-off when the track is lost during q1; outcome judging and time-outs.
+  void update(int64_t now);
+  void judge(int64_t now);
+  /// The request in flight was executed, or `failed` (`how`: "rejected", "did not answer").
+  void answered(bool failed, const std::string& how, int64_t now);
+  void refuse(std::string message);
+  void set_message(std::string message);
+  /// Ends a grasp in progress with kAborted (abort, release).
+  void abort_grasp(const std::string& why);
+  bool grasp_in_progress() const;
+  /// A tool target check: table plus margin and the workspace box; "" when fine.
+  std::string check_target(const Eigen::Vector3d& target) const;
+  ArmRequest make(Kind kind, int8_t mode, int8_t gripper, int64_t now);
+  std::optional<ArmRequest> cartesian(Kind kind, const Eigen::Vector3d& position,
+                                      const Eigen::Vector3d& rpy, int8_t gripper, int64_t now);
+  std::optional<ArmRequest> aim(Kind kind, int64_t now);
+
+  ArmGeometry geometry_;
+  GraspSettings settings_;
+  GraspStatusView status_;
+  int64_t next_sequence_;
+  double delay_;
+
+  ArmView arm_;
+  bool have_arm_ = false;
+  std::optional<PredictedPath> path_;
+  int64_t path_source_utime_ = 0;
+  std::optional<Eigen::Vector3d> measured_;  ///< last visible measurement
+  int64_t measured_utime_ = 0;
+
+  std::optional<InFlight> in_flight_;
+  std::map<int64_t, int> motion_commands_;  ///< sequence -> motion commands, for the delay
+  double seen_interaction_time_ = 0;
+
+  bool open_pending_ = true;  ///< a0 to send (start, release)
+  bool stop_pending_ = false;
+  bool home_pending_ = false;
+  bool lift_pending_ = false;
+  bool backoff_pending_ = false;
+  bool message_is_refusal_ = false;
+
+  Eigen::Vector3d approach_position_ = Eigen::Vector3d::Zero();  ///< a1's target, for the lift
+  Eigen::Vector3d approach_rpy_ = Eigen::Vector3d::Zero();
+
+  bool judging_ = false;
+  int64_t lifted_utime_ = 0;              ///< when the lift was reported executed
+  std::optional<int64_t> stopped_utime_;  ///< first status after it with the arm at rest
+};
+
+}  // namespace sg::arm

@@ -1,0 +1,139 @@
+// sg-grasp-ctl: the operator's side of sg-grasp. Sends one GRASP_COMMAND and prints GRASP_STATUS
+// until the machine has taken it up, or, with --wait, until the grasp (or release, or homing) is
+// over; `status` prints the machine's state.
+//
+//   sg-grasp-ctl track [--standoff 0.10]      # follow the ball, the gripper above it
+//   sg-grasp-ctl grasp --wait                 # q1 approach, q2 grasp, q3 closed, q4 lifted
+//   sg-grasp-ctl release | abort | home
+//   sg-grasp-ctl status [--follow]
+
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <optional>
+
+#include "common/bus.hpp"
+#include "common/clock.hpp"
+#include "common/program.hpp"
+#include "common/shutdown.hpp"
+#include "stereograsp/grasp_command_t.hpp"
+#include "stereograsp/grasp_status_t.hpp"
+
+namespace {
+
+using Cmd = stereograsp::grasp_command_t;
+using Status = stereograsp::grasp_status_t;
+
+const char* state_name(int8_t s) {
+  static const char* names[] = {"q0 hand opened", "q1 approaching", "q2 grasping", "q3 hand closed",
+                                "q4 object lifted"};
+  return s >= 0 && s <= 4 ? names[s] : "?";
+}
+const char* activity_name(int8_t a) {
+  static const char* names[] = {"idle", "tracking", "grasping", "homing", "backing off"};
+  return a >= 0 && a <= 4 ? names[a] : "?";
+}
+const char* outcome_name(int8_t o) {
+  static const char* names[] = {"none", "success", "failed", "aborted"};
+  return o >= 0 && o <= 3 ? names[o] : "?";
+}
+
+void print(const Status& s) {
+  std::printf("%-17s %-12s outcome %-8s", state_name(s.state), activity_name(s.activity),
+              outcome_name(s.outcome));
+  if (std::isfinite(s.target[0])) {
+    std::printf(" target (%.3f, %.3f, %.3f) m", s.target[0], s.target[1], s.target[2]);
+  }
+  if (!s.message.empty()) std::printf("  %s", s.message.c_str());
+  std::printf("\n");
+  std::fflush(stdout);
+}
+
+/// Handles the bus until `done(status)` or the time-out; returns the last status seen.
+std::optional<Status> watch(sg::Bus& bus, double timeout, bool follow,
+                            const std::function<bool(const Status&)>& done) {
+  std::optional<Status> last;
+  bus.subscribe<Status>("GRASP_STATUS", [&](const Status& s, const sg::ReceiveInfo&) {
+    if (follow && (!last || last->state != s.state || last->activity != s.activity ||
+                   last->outcome != s.outcome || last->message != s.message)) {
+      print(s);
+    }
+    last = s;
+  });
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout);
+  while (!sg::shutdown_requested() && std::chrono::steady_clock::now() < give_up &&
+         !(last && done(*last))) {
+    bus.handle(std::chrono::milliseconds(50));
+  }
+  return last;
+}
+
+int send(sg::Bus& bus, int8_t command, double standoff, bool wait, double timeout) {
+  Cmd c{};
+  c.utime = sg::now_utime();
+  c.sequence = c.utime;
+  c.command = command;
+  c.standoff = standoff;
+  c.sender = "sg-grasp-ctl";
+  bus.publish("GRASP_COMMAND", c);
+  // Done when the machine has moved on: for --wait, until it is idle with the grasp judged.
+  const auto finished = [&](const Status& s) {
+    if (s.utime < c.utime) return false;
+    if (!wait) return true;
+    if (command == Cmd::COMMAND_TRACK) return s.activity == Status::ACTIVITY_TRACKING;
+    if (command == Cmd::COMMAND_GRASP)
+      return s.activity != Status::ACTIVITY_GRASPING && s.outcome != Status::OUTCOME_NONE;
+    return s.activity == Status::ACTIVITY_IDLE;
+  };
+  const auto last = watch(bus, timeout, wait, finished);
+  if (!last) throw std::runtime_error("no GRASP_STATUS: is sg-grasp running on this bus?");
+  if (!finished(*last)) throw std::runtime_error("no answer within the time-out");
+  print(*last);
+  if (command == Cmd::COMMAND_GRASP && wait)
+    return last->outcome == Status::OUTCOME_SUCCESS ? 0 : 3;
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Commands sg-grasp (GRASP_COMMAND) and prints GRASP_STATUS.", "sg-grasp-ctl"};
+  sg::CommonOptions common;
+  sg::add_common_options(app, common);
+  double standoff = 0, timeout = 10;
+  bool wait = false, follow = false;
+  app.add_option("--timeout", timeout, "seconds to wait for sg-grasp (default 10; 60 with --wait)");
+  app.add_flag("--wait", wait,
+               "wait until the command has run its course (grasp: exit 0 on "
+               "success, 3 on failure)");
+  app.require_subcommand(1);
+  auto* track = app.add_subcommand("track", "follow the predicted ball at a stand-off above it");
+  track->add_option("--standoff", standoff, "m above the ball (default: sg-grasp's, 0.10)")
+      ->check(CLI::Range(0.0, 0.5));
+  auto* grasp = app.add_subcommand("grasp", "approach, close the hand, lift (q1..q4)");
+  auto* release = app.add_subcommand("release", "open the hand (a0)");
+  auto* abort = app.add_subcommand("abort", "stop the arm and open the hand");
+  auto* home = app.add_subcommand("home", "send the arm to its ready position");
+  auto* status = app.add_subcommand("status", "print GRASP_STATUS");
+  status->add_flag("--follow", follow, "keep printing changes until Ctrl-C");
+  return sg::run_program(app, argc, argv, [&] {
+    sg::load_common(common);
+    sg::install_shutdown_handlers();
+    sg::Bus bus(common.lcm_url);
+    if (wait && app.get_option("--timeout")->count() == 0) timeout = 60;
+    if (*status) {
+      const auto last =
+          watch(bus, follow ? 1e9 : timeout, follow, [&](const Status&) { return !follow; });
+      if (!last) throw std::runtime_error("no GRASP_STATUS: is sg-grasp running on this bus?");
+      if (!follow) print(*last);
+      return 0;
+    }
+    const int8_t command = *track     ? Cmd::COMMAND_TRACK
+                           : *grasp   ? Cmd::COMMAND_GRASP
+                           : *release ? Cmd::COMMAND_RELEASE
+                           : *abort   ? Cmd::COMMAND_ABORT
+                                      : Cmd::COMMAND_HOME;
+    (void)home;
+    return send(bus, command, standoff, wait, timeout);
+  });
+}

@@ -1,0 +1,761 @@
+// The grasp state machine (figure 4): its transition table for every state and command, a full
+// grasp q0 -> q4 judged a success and a failure, abort from every state, a lost track during the
+// approach, no command from a stale or lost trajectory, workspace and table refusals, one request
+// in flight, the delay learning and the --no-prediction mode. Fresh trajectories are a synthetic
+// circle (centre (0.45, 0, 0.10) m, radius 0.15 m, 1 rpm as in the paper) sampled at 4 Hz.
+
+#include "arm_driver/grasp_machine.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "stereograsp/arm_cmd_t.hpp"
+
+namespace sg::arm {
+namespace {
+
+using Cmd = stereograsp::arm_cmd_t;
+
+constexpr double kPi = std::numbers::pi;
+constexpr int64_t kSecond = 1'000'000;
+constexpr int64_t kT0 = 1'790'000'000 * kSecond;  // an arbitrary epoch time
+
+/// Where the emulated arm powers up: elbow and wrist at 90 degrees.
+Joints ready_joints() {
+  Joints q;
+  q << 0, 0, kPi / 2, 0, kPi / 2, 0;
+  return q;
+}
+
+/// The ball on the paper's circle at time t, at height z.
+Eigen::Vector3d circle(int64_t t, double z = 0.10) {
+  const double angle = 2 * kPi * static_cast<double>(t - kT0) / (60.0 * kSecond);
+  return {0.45 + 0.15 * std::cos(angle), 0.15 * std::sin(angle), z};
+}
+
+/// A prediction made at `utime`: 16 points of the circle at 4 Hz from utime + 250 ms.
+PredictedPath circle_path(int64_t utime, double z = 0.10) {
+  PredictedPath path;
+  path.utime = utime;
+  path.period_us = 250'000;
+  path.start_utime = utime + path.period_us;
+  for (int i = 0; i < 16; ++i) path.points.push_back(circle(path.start_utime + i * 250'000, z));
+  return path;
+}
+
+/// A path that goes nowhere in particular near `p`: 16 points at p.
+PredictedPath still_path(int64_t utime, const Eigen::Vector3d& p) {
+  return PredictedPath::hold(p, utime);
+}
+
+/// What a request does, for the transition table.
+enum class Req { kNone, kStop, kOpen, kHome, kMove, kApproach };
+
+const char* name(Req r) {
+  switch (r) {
+    case Req::kNone:
+      return "none";
+    case Req::kStop:
+      return "STOP+OPEN";
+    case Req::kOpen:
+      return "OPEN";
+    case Req::kHome:
+      return "HOME";
+    case Req::kMove:
+      return "MOVE";
+    case Req::kApproach:
+      return "MOVE+CLOSE";
+  }
+  return "?";
+}
+
+Req kind(const std::optional<ArmRequest>& r) {
+  if (!r) return Req::kNone;
+  if (r->mode == Cmd::MODE_STOP && r->gripper == Cmd::GRIPPER_OPEN) return Req::kStop;
+  if (r->mode == Cmd::MODE_GRIPPER_ONLY && r->gripper == Cmd::GRIPPER_OPEN) return Req::kOpen;
+  if (r->mode == Cmd::MODE_HOME && r->gripper == Cmd::GRIPPER_KEEP) return Req::kHome;
+  if (r->mode == Cmd::MODE_CARTESIAN && r->gripper == Cmd::GRIPPER_KEEP) return Req::kMove;
+  if (r->mode == Cmd::MODE_CARTESIAN && r->gripper == Cmd::GRIPPER_CLOSE) return Req::kApproach;
+  return Req::kNone;
+}
+
+/// A machine, a connected arm at the ready pose and a clock.
+struct Rig {
+  explicit Rig(GraspSettings s = {}) : settings(s), machine(geometry, s, 100) {
+    arm.connected = true;
+    arm.joints = ready_joints();
+    arm.tool = forward_kinematics(geometry, arm.joints).translation();
+    machine.on_arm_status(arm, now);
+  }
+
+  /// A fresh trajectory (made at now, from a frame captured 50 ms before).
+  void feed(double z = 0.10) { machine.on_trajectory(circle_path(now, z), now - 50'000, now); }
+  void lose() {
+    PredictedPath path = circle_path(now);
+    path.lost = true;
+    machine.on_trajectory(path, now - 50'000, now);
+  }
+  void advance(double seconds) { now += std::llround(seconds * kSecond); }
+  void command(GraspCommand c, double standoff = 0) { machine.on_command(c, standoff, now); }
+  std::optional<ArmRequest> take() { return machine.take_request(now); }
+  const GraspStatusView& status() const { return machine.status(); }
+
+  /// The arm reports `r` executed; a Cartesian target moves the arm there (its inverse
+  /// kinematics nearest the current joints).
+  void executed(const ArmRequest& r, bool moving = false, double interaction_time = 0) {
+    if (r.mode == Cmd::MODE_CARTESIAN) {
+      const IkResult ik = solve_nearest(geometry, pose_from_xyz_rpy(r.position, r.rpy), arm.joints);
+      if (ik.joints) arm.joints = *ik.joints;
+      arm.tool = forward_kinematics(geometry, arm.joints).translation();
+    }
+    arm.last_executed_sequence = r.sequence;
+    arm.moving = moving;
+    if (interaction_time > 0) arm.interaction_time = interaction_time;
+    machine.on_arm_status(arm, now);
+  }
+  void rejected(const ArmRequest& r) {
+    arm.last_rejected_sequence = r.sequence;
+    machine.on_arm_status(arm, now);
+  }
+
+  /// Takes the next request, which must exist, and reports it executed.
+  ArmRequest run(bool moving = false) {
+    std::optional<ArmRequest> r = take();
+    EXPECT_TRUE(r.has_value()) << status().message;
+    if (!r) return {};
+    executed(*r, moving);
+    return *r;
+  }
+
+  ArmGeometry geometry = ArmGeometry::a465();
+  GraspSettings settings;
+  int64_t now = kT0;
+  ArmView arm;
+  GraspMachine machine;
+};
+
+/// The situations of the transition table, each reached through the public API.
+enum class At {
+  kQ0Idle,
+  kQ0Tracking,
+  kQ0Homing,      // HOME asked for, not yet sent
+  kQ0BackingOff,  // the back-off not yet sent
+  kQ1,            // a1 not yet sent
+  kQ2,            // a1 + a2 in flight
+  kQ3Grasping,    // a3 not yet sent
+  kQ3Idle,        // the arm rejected the lift
+  kQ4Grasping,    // lifted, judging
+  kQ4Idle,        // judged: success
+};
+
+const char* name(At at) {
+  switch (at) {
+    case At::kQ0Idle:
+      return "q0 idle";
+    case At::kQ0Tracking:
+      return "q0 tracking";
+    case At::kQ0Homing:
+      return "q0 homing";
+    case At::kQ0BackingOff:
+      return "q0 backing off";
+    case At::kQ1:
+      return "q1 grasping";
+    case At::kQ2:
+      return "q2 grasping";
+    case At::kQ3Grasping:
+      return "q3 grasping";
+    case At::kQ3Idle:
+      return "q3 idle";
+    case At::kQ4Grasping:
+      return "q4 grasping";
+    case At::kQ4Idle:
+      return "q4 idle";
+  }
+  return "?";
+}
+
+/// Brings `rig` (fresh from its constructor) to `at`, answering every request on the way.
+void reach(Rig& rig, At at) {
+  ASSERT_EQ(kind(rig.take()), Req::kOpen);  // a0 first
+  rig.executed(ArmRequest{100});
+  rig.advance(0.8);
+  rig.feed();
+  switch (at) {
+    case At::kQ0Idle:
+      return;
+    case At::kQ0Tracking:
+      rig.command(GraspCommand::kTrack);
+      return;
+    case At::kQ0Homing:
+      rig.command(GraspCommand::kHome);
+      return;
+    default:
+      break;
+  }
+  rig.command(GraspCommand::kGrasp);
+  ASSERT_EQ(rig.status().state, GraspState::kApproaching) << rig.status().message;
+  if (at == At::kQ1) return;
+  if (at == At::kQ0BackingOff) {
+    rig.lose();
+    return;
+  }
+  const std::optional<ArmRequest> approach = rig.take();
+  ASSERT_EQ(kind(approach), Req::kApproach) << rig.status().message;
+  if (at == At::kQ2) return;
+  rig.advance(0.8);
+  rig.executed(*approach, true);
+  if (at == At::kQ3Grasping) return;
+  const std::optional<ArmRequest> lift = rig.take();
+  ASSERT_EQ(kind(lift), Req::kMove);
+  rig.advance(0.8);
+  if (at == At::kQ3Idle) {
+    rig.rejected(*lift);
+    return;
+  }
+  rig.executed(*lift, true);
+  if (at == At::kQ4Grasping) return;
+  rig.advance(0.3);
+  rig.arm.moving = false;
+  rig.machine.on_arm_status(rig.arm, rig.now);
+  rig.advance(0.1);
+  rig.machine.on_measurement(rig.arm.tool, rig.now - 20'000);
+}
+
+struct Expect {
+  GraspState state;
+  GraspActivity activity;
+};
+
+const std::vector<At> kEverySituation = {
+    At::kQ0Idle, At::kQ0Tracking, At::kQ0Homing, At::kQ0BackingOff, At::kQ1,
+    At::kQ2,     At::kQ3Grasping, At::kQ3Idle,   At::kQ4Grasping,   At::kQ4Idle};
+
+// Each situation reached through the public API shows the state and activity the table says.
+TEST(GraspMachineTest, SituationsShowTheirStateAndActivity) {
+  const std::vector<Expect> expected = {
+      {GraspState::kHandOpened, GraspActivity::kIdle},
+      {GraspState::kHandOpened, GraspActivity::kTracking},
+      {GraspState::kHandOpened, GraspActivity::kHoming},
+      {GraspState::kHandOpened, GraspActivity::kBackingOff},
+      {GraspState::kApproaching, GraspActivity::kGrasping},
+      {GraspState::kGrasping, GraspActivity::kGrasping},
+      {GraspState::kHandClosed, GraspActivity::kGrasping},
+      {GraspState::kHandClosed, GraspActivity::kIdle},
+      {GraspState::kObjectLifted, GraspActivity::kGrasping},
+      {GraspState::kObjectLifted, GraspActivity::kIdle},
+  };
+  for (std::size_t i = 0; i < kEverySituation.size(); ++i) {
+    SCOPED_TRACE(name(kEverySituation[i]));
+    Rig rig;
+    reach(rig, kEverySituation[i]);
+    EXPECT_EQ(rig.status().state, expected[i].state) << to_string(rig.status().state);
+    EXPECT_EQ(rig.status().activity, expected[i].activity) << to_string(rig.status().activity);
+  }
+}
+
+// Every situation times every command: the state and activity after the command and the kind of
+// request take_request() makes next (a fresh trajectory is always at hand).
+TEST(GraspMachineTest, TransitionTable) {
+  using S = GraspState;
+  using A = GraspActivity;
+  struct Row {
+    At at;
+    GraspCommand command;
+    S state;
+    A activity;
+    Req request;
+  };
+  const S q0 = S::kHandOpened, q1 = S::kApproaching, q2 = S::kGrasping, q3 = S::kHandClosed,
+          q4 = S::kObjectLifted;
+  const A idle = A::kIdle, tracking = A::kTracking, grasping = A::kGrasping, homing = A::kHoming,
+          backing = A::kBackingOff;
+  const GraspCommand track = GraspCommand::kTrack, grasp = GraspCommand::kGrasp,
+                     release = GraspCommand::kRelease, abort = GraspCommand::kAbort,
+                     home = GraspCommand::kHome;
+  const std::vector<Row> table = {
+      {At::kQ0Idle, track, q0, tracking, Req::kMove},
+      {At::kQ0Idle, grasp, q1, grasping, Req::kApproach},
+      {At::kQ0Idle, release, q0, idle, Req::kNone},
+      {At::kQ0Idle, abort, q0, idle, Req::kStop},
+      {At::kQ0Idle, home, q0, homing, Req::kHome},
+      {At::kQ0Tracking, track, q0, tracking, Req::kMove},
+      {At::kQ0Tracking, grasp, q1, grasping, Req::kApproach},
+      {At::kQ0Tracking, release, q0, tracking, Req::kMove},
+      {At::kQ0Tracking, abort, q0, idle, Req::kStop},
+      {At::kQ0Tracking, home, q0, homing, Req::kHome},
+      {At::kQ0Homing, track, q0, tracking, Req::kMove},
+      {At::kQ0Homing, grasp, q1, grasping, Req::kApproach},
+      {At::kQ0Homing, release, q0, homing, Req::kHome},
+      {At::kQ0Homing, abort, q0, idle, Req::kStop},
+      {At::kQ0Homing, home, q0, homing, Req::kHome},
+      {At::kQ0BackingOff, track, q0, backing, Req::kMove},
+      {At::kQ0BackingOff, grasp, q0, backing, Req::kMove},
+      {At::kQ0BackingOff, release, q0, backing, Req::kMove},
+      {At::kQ0BackingOff, abort, q0, idle, Req::kStop},
+      {At::kQ0BackingOff, home, q0, backing, Req::kMove},
+      {At::kQ1, track, q1, grasping, Req::kApproach},
+      {At::kQ1, grasp, q1, grasping, Req::kApproach},
+      {At::kQ1, release, q1, grasping, Req::kApproach},
+      {At::kQ1, abort, q0, idle, Req::kStop},
+      {At::kQ1, home, q1, grasping, Req::kApproach},
+      {At::kQ2, track, q2, grasping, Req::kNone},
+      {At::kQ2, grasp, q2, grasping, Req::kNone},
+      {At::kQ2, release, q2, grasping, Req::kNone},
+      {At::kQ2, abort, q0, idle, Req::kStop},
+      {At::kQ2, home, q2, grasping, Req::kNone},
+      {At::kQ3Grasping, track, q3, grasping, Req::kMove},
+      {At::kQ3Grasping, grasp, q3, grasping, Req::kMove},
+      {At::kQ3Grasping, release, q3, idle, Req::kOpen},
+      {At::kQ3Grasping, abort, q0, idle, Req::kStop},
+      {At::kQ3Grasping, home, q3, grasping, Req::kMove},
+      {At::kQ3Idle, track, q3, idle, Req::kNone},
+      {At::kQ3Idle, grasp, q3, idle, Req::kNone},
+      {At::kQ3Idle, release, q3, idle, Req::kOpen},
+      {At::kQ3Idle, abort, q0, idle, Req::kStop},
+      {At::kQ3Idle, home, q3, homing, Req::kHome},
+      {At::kQ4Grasping, track, q4, grasping, Req::kNone},
+      {At::kQ4Grasping, grasp, q4, grasping, Req::kNone},
+      {At::kQ4Grasping, release, q4, idle, Req::kOpen},
+      {At::kQ4Grasping, abort, q0, idle, Req::kStop},
+      {At::kQ4Grasping, home, q4, grasping, Req::kNone},
+      {At::kQ4Idle, track, q4, idle, Req::kNone},
+      {At::kQ4Idle, grasp, q4, idle, Req::kNone},
+      {At::kQ4Idle, release, q4, idle, Req::kOpen},
+      {At::kQ4Idle, abort, q0, idle, Req::kStop},
+      {At::kQ4Idle, home, q4, homing, Req::kHome},
+  };
+  ASSERT_EQ(table.size(), kEverySituation.size() * 5);
+  for (const Row& row : table) {
+    SCOPED_TRACE(std::string(name(row.at)) + " + " + to_string(row.command));
+    Rig rig;
+    reach(rig, row.at);
+    rig.advance(0.1);
+    rig.feed();
+    rig.command(row.command);
+    EXPECT_EQ(rig.status().state, row.state) << to_string(rig.status().state);
+    EXPECT_EQ(rig.status().activity, row.activity) << to_string(rig.status().activity);
+    const std::optional<ArmRequest> r = rig.take();
+    EXPECT_EQ(kind(r), row.request) << name(kind(r)) << " / " << rig.status().message;
+  }
+}
+
+// A refused or ignored command says why in the status message.
+TEST(GraspMachineTest, RefusedCommandsSayWhy) {
+  Rig rig;
+  reach(rig, At::kQ0Idle);
+  rig.command(GraspCommand::kRelease);
+  EXPECT_NE(rig.status().message.find("release ignored"), std::string::npos);
+  rig.advance(2.0);  // the trajectory is now stale
+  rig.command(GraspCommand::kGrasp);
+  EXPECT_EQ(rig.status().state, GraspState::kHandOpened);
+  EXPECT_NE(rig.status().message.find("no fresh track"), std::string::npos);
+  Rig holding;
+  reach(holding, At::kQ4Idle);
+  holding.command(GraspCommand::kTrack);
+  EXPECT_NE(holding.status().message.find("release the object first"), std::string::npos);
+}
+
+// The first request, once the arm is connected, is a0: open the hand.
+TEST(GraspMachineTest, FirstRequestOpensTheHandOnceConnected) {
+  GraspMachine machine(ArmGeometry::a465(), {}, 7);
+  EXPECT_FALSE(machine.take_request(kT0).has_value());  // no arm status yet
+  ArmView arm;
+  arm.connected = false;
+  machine.on_arm_status(arm, kT0);
+  EXPECT_FALSE(machine.take_request(kT0).has_value());
+  arm.connected = true;
+  machine.on_arm_status(arm, kT0 + 1000);
+  const std::optional<ArmRequest> r = machine.take_request(kT0 + 1000);
+  ASSERT_TRUE(r.has_value());
+  EXPECT_EQ(r->sequence, 7);
+  EXPECT_EQ(r->mode, Cmd::MODE_GRIPPER_ONLY);
+  EXPECT_EQ(r->gripper, Cmd::GRIPPER_OPEN);
+  EXPECT_EQ(machine.status().last_action, GraspAction::kOpenHand);
+  EXPECT_EQ(machine.status().state, GraspState::kHandOpened);
+  EXPECT_EQ(machine.status().activity, GraspActivity::kIdle);
+}
+
+// Tracking aims at the ball's predicted position at arrival, the stand-off above it, and a
+// track command's stand-off replaces the default.
+TEST(GraspMachineTest, TrackingAimsAboveThePredictedPosition) {
+  Rig rig;
+  reach(rig, At::kQ0Idle);
+  rig.command(GraspCommand::kTrack);
+  const std::optional<ArmRequest> r = rig.take();
+  ASSERT_TRUE(r.has_value()) << rig.status().message;
+  EXPECT_EQ(r->mode, Cmd::MODE_CARTESIAN);
+  EXPECT_EQ(r->gripper, Cmd::GRIPPER_KEEP);
+  EXPECT_DOUBLE_EQ(r->speed, 0.5);
+  EXPECT_EQ(r->source_utime, rig.now - 50'000);
+  EXPECT_GE(r->target_utime, rig.now + std::llround(0.78 * kSecond));
+  const Eigen::Vector3d ball = circle(r->target_utime);
+  EXPECT_LT((r->position - (ball + Eigen::Vector3d(0, 0, 0.10))).norm(), 0.005);
+  ASSERT_TRUE(rig.status().target.has_value());
+  EXPECT_TRUE(*rig.status().target == r->position);
+  EXPECT_EQ(rig.status().target_utime, r->target_utime);
+  EXPECT_EQ(rig.status().state, GraspState::kHandOpened);
+
+  rig.advance(0.8);
+  rig.executed(*r);
+  rig.feed();
+  rig.command(GraspCommand::kTrack, 0.2);
+  const std::optional<ArmRequest> higher = rig.take();
+  ASSERT_TRUE(higher.has_value()) << rig.status().message;
+  EXPECT_LT((higher->position - (circle(higher->target_utime) + Eigen::Vector3d(0, 0, 0.2))).norm(),
+            0.005);
+}
+
+// A whole grasp: a1 with the close in one request (q2), q3 when executed, a3 straight up by
+// `lift`, q4, then success from a measurement at the tool taken after the arm stopped, and a0.
+TEST(GraspMachineTest, FullGraspSucceeds) {
+  Rig rig;
+  reach(rig, At::kQ0Tracking);
+  rig.run();
+  rig.advance(0.8);
+  rig.feed();
+  rig.command(GraspCommand::kGrasp);
+  EXPECT_EQ(rig.status().state, GraspState::kApproaching);
+  EXPECT_EQ(rig.status().last_action, GraspAction::kApproachObject);
+
+  const std::optional<ArmRequest> approach = rig.take();
+  ASSERT_EQ(kind(approach), Req::kApproach) << rig.status().message;
+  const double delay = rig.machine.delay_estimate();
+  // The close executes one delay after the motion starts: T >= now + 2 delays.
+  EXPECT_GE(approach->target_utime, rig.now + std::llround(2 * delay * kSecond) - 1000);
+  EXPECT_LT((approach->position - circle(approach->target_utime)).norm(), 0.005);
+  EXPECT_EQ(rig.status().state, GraspState::kGrasping);
+  EXPECT_EQ(rig.status().last_action, GraspAction::kCloseHand);
+  EXPECT_FALSE(rig.take().has_value());  // in flight
+
+  rig.advance(0.8);
+  rig.executed(*approach, true);
+  EXPECT_EQ(rig.status().state, GraspState::kHandClosed);
+  const std::optional<ArmRequest> lift = rig.take();
+  ASSERT_EQ(kind(lift), Req::kMove) << rig.status().message;
+  EXPECT_LT((lift->position - (approach->position + Eigen::Vector3d(0, 0, 0.15))).norm(), 1e-12);
+  EXPECT_LT((lift->rpy - approach->rpy).norm(), 1e-12);
+  EXPECT_EQ(rig.status().last_action, GraspAction::kLiftObject);
+  EXPECT_EQ(rig.status().state, GraspState::kHandClosed);
+
+  rig.advance(0.8);
+  rig.machine.on_measurement(rig.arm.tool, rig.now - 10'000);  // before the lift: no verdict
+  rig.executed(*lift, true);
+  EXPECT_EQ(rig.status().state, GraspState::kObjectLifted);
+  EXPECT_EQ(rig.status().outcome, GraspOutcome::kNone);
+  rig.advance(0.3);
+  rig.machine.on_measurement(rig.arm.tool, rig.now);  // still moving: no verdict
+  EXPECT_EQ(rig.status().outcome, GraspOutcome::kNone);
+  rig.advance(0.1);
+  rig.arm.moving = false;
+  rig.machine.on_arm_status(rig.arm, rig.now);
+  EXPECT_EQ(rig.status().outcome, GraspOutcome::kNone);  // that measurement was before the stop
+  rig.advance(0.25);
+  rig.machine.on_measurement(std::nullopt, rig.now);  // not visible: no verdict yet
+  EXPECT_EQ(rig.status().outcome, GraspOutcome::kNone);
+  rig.advance(0.25);
+  rig.machine.on_measurement(rig.arm.tool + Eigen::Vector3d(0.01, 0.02, 0), rig.now);
+  EXPECT_EQ(rig.status().outcome, GraspOutcome::kSuccess) << rig.status().message;
+  EXPECT_EQ(rig.status().activity, GraspActivity::kIdle);
+  EXPECT_EQ(rig.status().state, GraspState::kObjectLifted);
+
+  rig.command(GraspCommand::kRelease);
+  const std::optional<ArmRequest> open = rig.take();
+  EXPECT_EQ(kind(open), Req::kOpen);
+  EXPECT_EQ(rig.status().state, GraspState::kHandOpened);
+  EXPECT_EQ(rig.status().last_action, GraspAction::kOpenHand);
+  EXPECT_EQ(rig.status().outcome, GraspOutcome::kSuccess);
+}
+
+// After the lift, a ball measured far from the tool means the grasp failed; the message gives
+// the distance.
+TEST(GraspMachineTest, FullGraspFailsWhenTheBallIsNotAtTheTool) {
+  Rig rig;
+  reach(rig, At::kQ4Grasping);
+  rig.advance(0.5);
+  rig.arm.moving = false;
+  rig.machine.on_arm_status(rig.arm, rig.now);
+  rig.advance(0.25);
+  rig.machine.on_measurement(rig.arm.tool + Eigen::Vector3d(0, 0, -0.30), rig.now);
+  EXPECT_EQ(rig.status().outcome, GraspOutcome::kFailed);
+  EXPECT_EQ(rig.status().activity, GraspActivity::kIdle);
+  EXPECT_EQ(rig.status().state, GraspState::kObjectLifted);
+  EXPECT_NE(rig.status().message.find("0.300 m"), std::string::npos) << rig.status().message;
+}
+
+// After the lift, no visible ball within max_trajectory_age of the arm stopping is a failure.
+TEST(GraspMachineTest, BallNotSeenAfterTheLiftFails) {
+  Rig rig;
+  reach(rig, At::kQ4Grasping);
+  rig.arm.moving = false;
+  rig.machine.on_arm_status(rig.arm, rig.now);
+  rig.advance(0.9);
+  rig.machine.on_arm_status(rig.arm, rig.now);
+  EXPECT_EQ(rig.status().outcome, GraspOutcome::kNone);
+  rig.advance(0.2);
+  rig.machine.on_arm_status(rig.arm, rig.now);
+  EXPECT_EQ(rig.status().outcome, GraspOutcome::kFailed);
+  EXPECT_NE(rig.status().message.find("not seen"), std::string::npos);
+}
+
+// Abort from every situation sends STOP with the hand opening (even with a request in flight),
+// ends in q0 idle, and marks a grasp in progress aborted.
+TEST(GraspMachineTest, AbortFromEveryStateStopsAndOpens) {
+  for (At at : kEverySituation) {
+    SCOPED_TRACE(name(at));
+    Rig rig;
+    reach(rig, at);
+    const GraspOutcome before = rig.status().outcome;
+    const bool in_progress = rig.status().activity == GraspActivity::kGrasping;
+    rig.command(GraspCommand::kAbort);
+    const std::optional<ArmRequest> r = rig.take();
+    ASSERT_TRUE(r.has_value());
+    EXPECT_EQ(r->mode, Cmd::MODE_STOP);
+    EXPECT_EQ(r->gripper, Cmd::GRIPPER_OPEN);
+    EXPECT_EQ(rig.status().state, GraspState::kHandOpened);
+    EXPECT_EQ(rig.status().activity, GraspActivity::kIdle);
+    EXPECT_EQ(rig.status().last_action, GraspAction::kOpenHand);
+    EXPECT_FALSE(rig.status().target.has_value());
+    EXPECT_EQ(rig.status().outcome, in_progress ? GraspOutcome::kAborted : before);
+    rig.executed(*r);
+    rig.advance(0.8);
+    rig.feed();
+    EXPECT_FALSE(rig.take().has_value());  // idle: nothing more
+  }
+}
+
+// A trajectory marked lost during the approach: the tool backs off straight up by `backoff`
+// from where it is, with the same orientation, and the grasp ends in q0 with outcome failed.
+TEST(GraspMachineTest, LostTrackDuringApproachBacksOff) {
+  Rig rig;
+  reach(rig, At::kQ0Tracking);
+  const ArmRequest tracked = rig.run();
+  rig.advance(0.8);
+  rig.feed();
+  rig.command(GraspCommand::kGrasp);
+  rig.lose();
+  EXPECT_EQ(rig.status().state, GraspState::kHandOpened);
+  EXPECT_EQ(rig.status().activity, GraspActivity::kBackingOff);
+  EXPECT_EQ(rig.status().outcome, GraspOutcome::kFailed);
+  EXPECT_EQ(rig.status().message, "track lost");
+  const std::optional<ArmRequest> r = rig.take();
+  ASSERT_EQ(kind(r), Req::kMove);
+  EXPECT_LT((r->position - (rig.arm.tool + Eigen::Vector3d(0, 0, 0.10))).norm(), 1e-12);
+  const Eigen::Matrix3d before = pose_from_xyz_rpy(tracked.position, tracked.rpy).rotation();
+  const Eigen::Matrix3d after = pose_from_xyz_rpy(r->position, r->rpy).rotation();
+  EXPECT_LT((after - before).norm(), 1e-6);  // the tool keeps its orientation
+  rig.advance(0.8);
+  rig.executed(*r);
+  EXPECT_EQ(rig.status().state, GraspState::kHandOpened);
+  EXPECT_EQ(rig.status().activity, GraspActivity::kIdle);
+  EXPECT_EQ(rig.status().outcome, GraspOutcome::kFailed);
+  rig.feed();
+  EXPECT_FALSE(rig.take().has_value());
+}
+
+// No trajectory newer than max_trajectory_age during the approach also counts as a lost track.
+TEST(GraspMachineTest, StaleTrackDuringApproachBacksOff) {
+  Rig rig;
+  reach(rig, At::kQ1);
+  rig.advance(0.9);
+  EXPECT_EQ(kind(rig.take()), Req::kApproach);  // still fresh: approaches
+  Rig late;
+  reach(late, At::kQ1);
+  late.advance(1.1);
+  const std::optional<ArmRequest> r = late.take();
+  ASSERT_EQ(kind(r), Req::kMove);
+  EXPECT_NEAR(r->position.z(), late.arm.tool.z() + 0.10, 1e-12);
+  EXPECT_EQ(late.status().activity, GraspActivity::kBackingOff);
+  EXPECT_EQ(late.status().outcome, GraspOutcome::kFailed);
+}
+
+// While tracking, a stale or lost trajectory gives no command, and tracking resumes when a
+// fresh one arrives.
+TEST(GraspMachineTest, NoCommandFromStaleOrLostTrajectory) {
+  Rig rig;
+  reach(rig, At::kQ0Tracking);
+  rig.machine.on_trajectory(circle_path(rig.now - 1'100'000), rig.now - 1'150'000, rig.now);
+  EXPECT_FALSE(rig.take().has_value());
+  EXPECT_NE(rig.status().message.find("no fresh track"), std::string::npos);
+  rig.lose();
+  EXPECT_FALSE(rig.take().has_value());
+  EXPECT_EQ(rig.status().activity, GraspActivity::kTracking);
+  rig.advance(0.25);
+  rig.feed();
+  const std::optional<ArmRequest> r = rig.take();
+  EXPECT_EQ(kind(r), Req::kMove);
+  EXPECT_EQ(rig.status().message, "");
+}
+
+// A path below the table (plus margin) or outside the workspace gives no request and a message;
+// the machine stays where it is.
+TEST(GraspMachineTest, RefusesTargetsBelowTheTableOrOutsideTheWorkspace) {
+  Rig rig;
+  reach(rig, At::kQ0Tracking);
+  rig.feed(-0.20);  // tool target at -0.10 m
+  EXPECT_FALSE(rig.take().has_value());
+  EXPECT_NE(rig.status().message.find("below the table"), std::string::npos)
+      << rig.status().message;
+  EXPECT_EQ(rig.status().activity, GraspActivity::kTracking);
+
+  rig.machine.on_trajectory(still_path(rig.now, {1.5, 0, 0.10}), rig.now, rig.now);
+  EXPECT_FALSE(rig.take().has_value());
+  EXPECT_NE(rig.status().message.find("target refused"), std::string::npos);
+
+  rig.feed(0.02);  // grasping a ball 2 cm above the table: the TCP would be below the margin
+  rig.command(GraspCommand::kGrasp);
+  ASSERT_EQ(rig.status().state, GraspState::kApproaching);
+  EXPECT_FALSE(rig.take().has_value());
+  EXPECT_EQ(rig.status().state, GraspState::kApproaching);
+  EXPECT_NE(rig.status().message.find("below the table"), std::string::npos);
+}
+
+// Only one request is in flight: the next comes after the arm reports the previous executed or
+// rejected, with sequence numbers one apart; abort alone is sent at once.
+TEST(GraspMachineTest, AtMostOneRequestInFlight) {
+  Rig rig;
+  reach(rig, At::kQ0Tracking);
+  const std::optional<ArmRequest> first = rig.take();
+  ASSERT_TRUE(first.has_value());
+  EXPECT_EQ(first->sequence, 101);
+  for (int i = 0; i < 3; ++i) {
+    rig.advance(0.25);
+    rig.feed();
+    EXPECT_FALSE(rig.take().has_value());
+  }
+  rig.arm.last_executed_sequence = 55;  // someone else's command
+  rig.machine.on_arm_status(rig.arm, rig.now);
+  EXPECT_FALSE(rig.take().has_value());
+  rig.executed(*first);
+  const std::optional<ArmRequest> second = rig.take();
+  ASSERT_TRUE(second.has_value());
+  EXPECT_EQ(second->sequence, 102);
+  EXPECT_FALSE(rig.take().has_value());
+  rig.command(GraspCommand::kAbort);
+  const std::optional<ArmRequest> stop = rig.take();
+  ASSERT_EQ(kind(stop), Req::kStop);
+  EXPECT_EQ(stop->sequence, 103);
+  EXPECT_FALSE(rig.take().has_value());
+}
+
+// A request the arm rejects frees the slot and is treated like a refusal: a message, and the
+// machine tries again (an approach goes back to q1).
+TEST(GraspMachineTest, RejectedRequestIsARefusal) {
+  Rig rig;
+  reach(rig, At::kQ0Tracking);
+  const std::optional<ArmRequest> r = rig.take();
+  ASSERT_TRUE(r.has_value());
+  rig.rejected(*r);
+  EXPECT_NE(rig.status().message.find("rejected"), std::string::npos);
+  EXPECT_EQ(rig.status().activity, GraspActivity::kTracking);
+  EXPECT_TRUE(rig.take().has_value());
+
+  Rig approach;
+  reach(approach, At::kQ2);
+  const ArmRequest sent{approach.arm.last_executed_sequence + 1};
+  approach.rejected(sent);
+  EXPECT_EQ(approach.status().state, GraspState::kApproaching);
+  EXPECT_EQ(approach.status().last_action, GraspAction::kApproachObject);
+  EXPECT_NE(approach.status().message.find("rejected the approach"), std::string::npos);
+  approach.feed();
+  EXPECT_EQ(kind(approach.take()), Req::kApproach);
+}
+
+// A request with no answer for kAnswerTimeout (or 8 delays, if longer) is given up like a
+// rejected one.
+TEST(GraspMachineTest, UnansweredRequestTimesOut) {
+  Rig rig;
+  reach(rig, At::kQ0Tracking);
+  ASSERT_TRUE(rig.take().has_value());
+  const double limit = std::max(GraspMachine::kAnswerTimeout, 8 * rig.machine.delay_estimate());
+  rig.advance(limit - 0.1);
+  rig.feed();
+  EXPECT_FALSE(rig.take().has_value());
+  rig.advance(0.2);
+  rig.feed();
+  EXPECT_TRUE(rig.take().has_value());
+}
+
+// The delay estimate starts at default_delay and follows the measured interaction times, an
+// interaction with N motion commands counting as N delays; other senders' interactions and a
+// repeated value are not learnt.
+TEST(GraspMachineTest, LearnsTheDelay) {
+  Rig rig;
+  EXPECT_DOUBLE_EQ(rig.machine.delay_estimate(), 0.78);
+  const std::optional<ArmRequest> open = rig.take();  // a0: one command (OPEN)
+  ASSERT_TRUE(open.has_value());
+  rig.executed(*open, false, 0.90);
+  const double after_one = 0.7 * 0.78 + 0.3 * 0.90;
+  EXPECT_NEAR(rig.machine.delay_estimate(), after_one, 1e-12);
+  rig.machine.on_arm_status(rig.arm, rig.now);  // the same interaction again: not counted twice
+  EXPECT_NEAR(rig.machine.delay_estimate(), after_one, 1e-12);
+  rig.arm.last_executed_sequence = 55;  // another sender's interaction
+  rig.arm.interaction_time = 3.0;
+  rig.machine.on_arm_status(rig.arm, rig.now);
+  EXPECT_NEAR(rig.machine.delay_estimate(), after_one, 1e-12);
+
+  rig.feed();
+  rig.command(GraspCommand::kGrasp);
+  const std::optional<ArmRequest> approach = rig.take();  // MA + CLOSE: two delays
+  ASSERT_EQ(kind(approach), Req::kApproach) << rig.status().message;
+  // The executed status comes first, the interaction time with the next status (the driver).
+  rig.executed(*approach, true);
+  EXPECT_NEAR(rig.machine.delay_estimate(), after_one, 1e-12);
+  rig.arm.interaction_time = 1.40;
+  rig.machine.on_arm_status(rig.arm, rig.now);
+  EXPECT_NEAR(rig.machine.delay_estimate(), 0.7 * after_one + 0.3 * 0.70, 1e-12);
+}
+
+// --no-prediction: the target is the last measured position (plus the stand-off); trajectories
+// are ignored, and a measurement older than max_trajectory_age gives no command.
+TEST(GraspMachineTest, NoPredictionAimsAtTheLastMeasurement) {
+  GraspSettings settings;
+  settings.use_prediction = false;
+  Rig rig(settings);
+  ASSERT_EQ(kind(rig.take()), Req::kOpen);
+  rig.executed(ArmRequest{100});
+  rig.feed();  // ignored
+  rig.command(GraspCommand::kTrack);
+  EXPECT_FALSE(rig.take().has_value());  // nothing measured yet
+  const Eigen::Vector3d ball(0.50, 0.10, 0.12);
+  rig.machine.on_measurement(ball, rig.now - 100'000);
+  rig.machine.on_measurement(std::nullopt, rig.now - 50'000);  // not visible: keeps the last
+  const std::optional<ArmRequest> r = rig.take();
+  ASSERT_EQ(kind(r), Req::kMove) << rig.status().message;
+  EXPECT_LT((r->position - (ball + Eigen::Vector3d(0, 0, 0.10))).norm(), 1e-9);
+  EXPECT_EQ(r->source_utime, rig.now - 100'000);
+
+  rig.advance(0.8);
+  rig.executed(*r);
+  rig.command(GraspCommand::kGrasp);
+  const std::optional<ArmRequest> approach = rig.take();
+  ASSERT_EQ(kind(approach), Req::kApproach) << rig.status().message;
+  EXPECT_LT((approach->position - ball).norm(), 1e-9);
+
+  Rig stale(settings);
+  ASSERT_EQ(kind(stale.take()), Req::kOpen);
+  stale.executed(ArmRequest{100});
+  stale.command(GraspCommand::kTrack);
+  stale.machine.on_measurement(ball, stale.now - 1'100'000);
+  EXPECT_FALSE(stale.take().has_value());
+}
+
+// The names shown on GRASP_STATUS and in logs.
+TEST(GraspMachineTest, Names) {
+  EXPECT_STREQ(to_string(GraspState::kHandOpened), "q0 hand opened");
+  EXPECT_STREQ(to_string(GraspState::kObjectLifted), "q4 object lifted");
+  EXPECT_STREQ(to_string(GraspActivity::kTracking), "tracking");
+  EXPECT_STREQ(to_string(GraspActivity::kBackingOff), "backing off");
+  EXPECT_STREQ(to_string(GraspAction::kCloseHand), "a2 close hand");
+  EXPECT_STREQ(to_string(GraspAction::kNone), "none");
+  EXPECT_STREQ(to_string(GraspOutcome::kSuccess), "success");
+  EXPECT_STREQ(to_string(GraspCommand::kAbort), "abort");
+}
+
+}  // namespace
+}  // namespace sg::arm
