@@ -96,9 +96,11 @@ sg::arm::ArmView view_of(const stereograsp::arm_status_t& s) {
   return v;
 }
 
-stereograsp::arm_cmd_t command_of(const sg::arm::ArmRequest& r, int64_t now) {
+/// `utime` is the message time of the decision (docs/architecture.md): the newest trajectory's,
+/// or the clock's before there is one.
+stereograsp::arm_cmd_t command_of(const sg::arm::ArmRequest& r, int64_t decision_utime) {
   stereograsp::arm_cmd_t c{};
-  c.utime = now;
+  c.utime = decision_utime;
   c.source_utime = r.source_utime;
   c.target_utime = r.target_utime;
   c.sequence = r.sequence;
@@ -137,7 +139,9 @@ int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
   sg::Bus bus(url);
   GraspMachine machine(geometry, settings, sg::now_utime());
   std::map<std::string, int64_t> last_command;  // per sender
+  int64_t trajectory_utime = 0;                 // the newest OBJECT_TRAJECTORY's
   bus.subscribe<stereograsp::trajectory_t>("OBJECT_TRAJECTORY", [&](const auto& m, const auto&) {
+    trajectory_utime = m.utime;
     if (auto path = path_from(m)) machine.on_trajectory(*path, m.source_utime, sg::now_utime());
   });
   bus.subscribe<stereograsp::point3_t>("OBJECT_POSITION", [&](const auto& m, const auto&) {
@@ -175,7 +179,7 @@ int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
     bus.handle(std::chrono::milliseconds(10));
     const int64_t now = sg::now_utime();
     if (auto request = machine.take_request(now)) {
-      bus.publish("ARM_COMMAND", command_of(*request, now));
+      bus.publish("ARM_COMMAND", command_of(*request, trajectory_utime ? trajectory_utime : now));
     }
     const std::string s = summary(machine.status());
     const auto t = std::chrono::steady_clock::now();
