@@ -13,6 +13,7 @@
 #include <map>
 
 #include "arm_driver/grasp_machine.hpp"
+#include "arm_driver/grasp_messages.hpp"
 #include "common/bus.hpp"
 #include "common/clock.hpp"
 #include "common/program.hpp"
@@ -57,75 +58,6 @@ sg::arm::GraspSettings load_settings(const sg::Config& c, const Options& o) {
   return s;
 }
 
-/// trajectory_t -> PredictedPath; nullopt (with a warning) for a malformed message.
-std::optional<sg::arm::PredictedPath> path_from(const stereograsp::trajectory_t& m) {
-  sg::arm::PredictedPath p;
-  p.utime = m.utime;
-  p.start_utime = m.start_utime;
-  p.period_us = m.period_us;
-  p.lost = m.status == stereograsp::trajectory_t::STATUS_LOST;
-  if (m.period_us <= 0 || m.num_points < 0 ||
-      static_cast<size_t>(m.num_points) != m.position.size()) {
-    spdlog::warn("OBJECT_TRAJECTORY at {}: period {} us, {} points: ignored", m.utime, m.period_us,
-                 m.num_points);
-    return std::nullopt;
-  }
-  for (const auto& q : m.position) {
-    if (q.size() != 3 || !std::isfinite(q[0]) || !std::isfinite(q[1]) || !std::isfinite(q[2])) {
-      if (p.lost) break;  // a lost track may carry NaNs
-      spdlog::warn("OBJECT_TRAJECTORY at {}: a point that is not 3 finite numbers: ignored",
-                   m.utime);
-      return std::nullopt;
-    }
-    p.points.emplace_back(q[0], q[1], q[2]);
-  }
-  return p;
-}
-
-sg::arm::ArmView view_of(const stereograsp::arm_status_t& s) {
-  using S = stereograsp::arm_status_t;
-  sg::arm::ArmView v;
-  v.connected = s.state != S::STATE_DISCONNECTED;
-  v.moving = s.state == S::STATE_MOVING;
-  v.error = s.state == S::STATE_ERROR;
-  v.last_executed_sequence = s.last_executed_sequence;
-  v.last_rejected_sequence = s.last_rejected_sequence;
-  for (int i = 0; i < 6; ++i) v.joints[i] = s.joints[i];
-  v.tool = {s.tool_position[0], s.tool_position[1], s.tool_position[2]};
-  v.interaction_time = s.interaction_time;
-  return v;
-}
-
-/// `utime` is the message time of the decision (docs/architecture.md): the newest trajectory's,
-/// or the clock's before there is one.
-stereograsp::arm_cmd_t command_of(const sg::arm::ArmRequest& r, int64_t decision_utime) {
-  stereograsp::arm_cmd_t c{};
-  c.utime = decision_utime;
-  c.source_utime = r.source_utime;
-  c.target_utime = r.target_utime;
-  c.sequence = r.sequence;
-  c.mode = r.mode;
-  for (int i = 0; i < 3; ++i) c.position[i] = r.position[i], c.orientation[i] = r.rpy[i];
-  c.gripper = r.gripper;
-  c.speed = r.speed;
-  c.sender = "sg-grasp";
-  return c;
-}
-
-stereograsp::grasp_status_t status_of(const sg::arm::GraspStatusView& v, int64_t now) {
-  stereograsp::grasp_status_t m{};
-  m.utime = now;
-  m.source_utime = v.source_utime;
-  m.state = static_cast<int8_t>(v.state);
-  m.activity = static_cast<int8_t>(v.activity);
-  m.last_action = static_cast<int8_t>(v.last_action);
-  for (int i = 0; i < 3; ++i) m.target[i] = v.target ? (*v.target)[i] : std::nan("");
-  m.target_utime = v.target_utime;
-  m.outcome = static_cast<int8_t>(v.outcome);
-  m.message = v.message;
-  return m;
-}
-
 /// The fields a person watches: a change of any is published and logged at once.
 std::string summary(const sg::arm::GraspStatusView& v) {
   return std::string(to_string(v.state)) + ", " + to_string(v.activity) + ", last " +
@@ -142,14 +74,19 @@ int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
   int64_t trajectory_utime = 0;                 // the newest OBJECT_TRAJECTORY's
   bus.subscribe<stereograsp::trajectory_t>("OBJECT_TRAJECTORY", [&](const auto& m, const auto&) {
     trajectory_utime = m.utime;
-    if (auto path = path_from(m)) machine.on_trajectory(*path, m.source_utime, sg::now_utime());
+    std::string why;
+    if (auto path = sg::arm::path_from(m, &why)) {
+      machine.on_trajectory(*path, m.source_utime, sg::now_utime());
+    } else {
+      spdlog::warn("OBJECT_TRAJECTORY at {}: {}; ignored", m.utime, why);
+    }
   });
   bus.subscribe<stereograsp::point3_t>("OBJECT_POSITION", [&](const auto& m, const auto&) {
     const Eigen::Vector3d p(m.position[0], m.position[1], m.position[2]);
     machine.on_measurement(m.visible && p.allFinite() ? std::optional(p) : std::nullopt, m.utime);
   });
   bus.subscribe<stereograsp::arm_status_t>("ARM_STATUS", [&](const auto& m, const auto&) {
-    machine.on_arm_status(view_of(m), sg::now_utime());
+    machine.on_arm_status(sg::arm::arm_view_of(m), sg::now_utime());
   });
   bus.subscribe<stereograsp::grasp_command_t>("GRASP_COMMAND", [&](const auto& m, const auto&) {
     auto [it, fresh] = last_command.try_emplace(m.sender, m.sequence);
@@ -179,12 +116,14 @@ int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
     bus.handle(std::chrono::milliseconds(10));
     const int64_t now = sg::now_utime();
     if (auto request = machine.take_request(now)) {
-      bus.publish("ARM_COMMAND", command_of(*request, trajectory_utime ? trajectory_utime : now));
+      // utime: the message time of the decision, the newest trajectory's (the clock's before one).
+      bus.publish("ARM_COMMAND",
+                  sg::arm::to_arm_cmd(*request, trajectory_utime ? trajectory_utime : now));
     }
     const std::string s = summary(machine.status());
     const auto t = std::chrono::steady_clock::now();
     if (s != last_summary || t >= next) {
-      bus.publish("GRASP_STATUS", status_of(machine.status(), now));
+      bus.publish("GRASP_STATUS", sg::arm::to_grasp_status(machine.status(), now));
       if (s != last_summary) spdlog::info("{}", s);
       last_summary = s;
       next = t + std::chrono::duration_cast<std::chrono::steady_clock::duration>(period);

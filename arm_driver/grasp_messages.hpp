@@ -1,0 +1,39 @@
+#pragma once
+
+/// The grasp machine's values as LCM messages and back: the one place sg-grasp and the in-process
+/// trials (sim/grasp_trial.hpp) convert, so both speak to the arm alike.
+///
+///     machine.on_arm_status(arm_view_of(arm_status), now);
+///     if (auto path = path_from(trajectory, &why)) machine.on_trajectory(*path, ...);
+///     bus.publish("ARM_COMMAND", to_arm_cmd(*machine.take_request(now), trajectory.utime));
+///     bus.publish("GRASP_STATUS", to_grasp_status(machine.status(), now));
+
+#include <optional>
+#include <string>
+
+#include "arm_driver/grasp_machine.hpp"
+#include "arm_driver/interception.hpp"
+#include "stereograsp/arm_cmd_t.hpp"
+#include "stereograsp/arm_status_t.hpp"
+#include "stereograsp/grasp_status_t.hpp"
+#include "stereograsp/trajectory_t.hpp"
+
+namespace sg::arm {
+
+/// An ArmRequest as the ARM_COMMAND it stands for; `utime` is the message time of the decision.
+stereograsp::arm_cmd_t to_arm_cmd(const ArmRequest& request, int64_t utime,
+                                  const std::string& sender = "sg-grasp");
+
+/// What the machine needs of an ARM_STATUS.
+ArmView arm_view_of(const stereograsp::arm_status_t& status);
+
+/// The machine's status as GRASP_STATUS (a missing target is NaN).
+stereograsp::grasp_status_t to_grasp_status(const GraspStatusView& view, int64_t utime);
+
+/// An OBJECT_TRAJECTORY as a path; nullopt, with the reason in `why`, when it is malformed (a
+/// period that is not positive, num_points that disagrees with the points, a point that is not
+/// three finite numbers in a track that is not lost).
+std::optional<PredictedPath> path_from(const stereograsp::trajectory_t& trajectory,
+                                       std::string* why = nullptr);
+
+}  // namespace sg::arm
