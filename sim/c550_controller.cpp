@@ -37,6 +37,9 @@ void check_params(const C550Params& p, const arm::ArmGeometry& geometry) {
   require(p.grasp_tolerance >= 0 && p.ball_radius > 0,
           format("grasp_tolerance %g m and ball_radius %g m must be >= 0 and > 0",
                  p.grasp_tolerance, p.ball_radius));
+  require(!p.start_holding || 2 * p.ball_radius < p.gripper_open_width,
+          format("start_holding: the ball (%g m across) does not fit the open gripper (%g m)",
+                 2 * p.ball_radius, p.gripper_open_width));
   require(p.ready.allFinite() && arm::within_limits(geometry, p.ready),
           "the ready joints are outside the arm's joint limits");
 }
@@ -64,7 +67,11 @@ C550Controller::C550Controller(arm::ArmGeometry geometry, C550Params params)
       rng_(params_.seed) {
   check_params(params_, geometry_);
   motion_ = {params_.ready, params_.ready, kNever, kNever};
-  stroke_ = {params_.gripper_open_width, params_.gripper_open_width, kNever, kNever};
+  const double width = params_.start_holding
+                           ? std::max(2 * params_.ball_radius, params_.gripper_closed_width)
+                           : params_.gripper_open_width;
+  stroke_ = {width, width, kNever, kNever};
+  holding_ = params_.start_holding;
   last_command_time_ = kNever;
 }
 

@@ -21,7 +21,8 @@
 ///  - the gripper moves between open and closed widths at a constant rate (gripper_time for the
 ///    full stroke); a CLOSE grasps the ball when its true centre is within grasp_tolerance of the
 ///    tool centre point at the time of the command and the fingers are open wider than the ball,
-///    and the fingers then stop on the ball (2 * ball_radius).
+///    and the fingers then stop on the ball (2 * ball_radius);
+///  - with start_holding the controller powers up with the ball already between the fingers.
 
 #include <Eigen/Core>
 #include <array>
@@ -49,6 +50,10 @@ struct C550Params {
   double gripper_closed_width = 0.0;  ///< between the fingers when closed on nothing
   double grasp_tolerance = 0.02;      ///< ball centre to TCP distance that still grasps
   double ball_radius = 0.035;
+  /// Power up holding the ball: the fingers closed on it (2 * ball_radius) and holding() true
+  /// until the first OPEN, as if it had been put in the gripper by hand (robot-guided
+  /// calibration, docs/calibration.md).
+  bool start_holding = false;
   /// READY, also the joints at power-up: elbow and wrist at 90 degrees, which with the A465
   /// puts the flange 0.33 m in front of the waist axis at z = 0.559 m, tool z axis straight down.
   arm::Joints ready =

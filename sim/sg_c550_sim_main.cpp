@@ -7,6 +7,7 @@
 //   sg-c550-sim --link /tmp/c550                   # then: sg-arm-driver --device /tmp/c550
 //   sg-c550-sim --garble-rate 0.001 --drop-ack-rate 0.01 --log-commands commands.tsv
 //   sg-c550-sim --disconnect-after 5 --reconnect-after 2
+//   sg-c550-sim --link /tmp/c550 --holding         # the ball in the gripper (robot calibration)
 
 #include <fcntl.h>
 #include <poll.h>
@@ -54,6 +55,7 @@ struct Options {
   double reconnect_after = 1.0;
   std::string log_commands;
   double state_rate = 50;
+  bool holding = false;
 };
 
 std::string system_error(const std::string& what) { return what + ": " + std::strerror(errno); }
@@ -379,6 +381,7 @@ void load_options(const CLI::App& app, const sg::Config& c, Options& o) {
   settle(app, "--reconnect-after", c, "reconnect_after", o.reconnect_after);
   settle(app, "--log-commands", c, "log_commands", o.log_commands);
   settle(app, "--state-rate", c, "state_rate", o.state_rate);
+  settle(app, "--holding", c, "holding", o.holding);
   check(o.slave >= 1 && o.slave <= 127, "--slave / c550_sim.slave must be 1..127");
   check(o.delay_min >= 0 && o.delay_min <= o.delay_max,
         "--delay-min / --delay-max: need 0 <= delay-min <= delay-max");
@@ -402,6 +405,7 @@ sg::sim::C550Params controller_params(const Options& o, const sg::Config& c) {
   p.gripper_closed_width = c.get<double>("c550_sim.gripper_closed_width", p.gripper_closed_width);
   p.grasp_tolerance = c.get<double>("c550_sim.grasp_tolerance", p.grasp_tolerance);
   p.ball_radius = c.get<double>("c550_sim.ball_radius", p.ball_radius);
+  p.start_holding = o.holding;
   return p;
 }
 
@@ -439,6 +443,10 @@ int main(int argc, char** argv) {
                  "append each RAPL command line received to FILE: utime, seconds since start, "
                  "command, tab-separated");
   app.add_option("--state-rate", o.state_rate, "SIM_ARM_STATE messages per second (default 50)");
+  app.add_flag("--holding", o.holding,
+               "start with the gripper closed on the ball (SIM_ARM_STATE holding_object, so "
+               "sg-camera-sim draws the ball at the tool centre point) until the first OPEN: "
+               "for sg-calibrate robot");
 
   return sg::run_program(app, argc, argv, [&] {
     const sg::Config config = sg::load_common(common);

@@ -1,6 +1,7 @@
 #include "vision/robot_calibration.hpp"
 
 #include <Eigen/Geometry>
+#include <cmath>
 
 namespace sg::vision {
 namespace {
@@ -16,7 +17,45 @@ double lerp(double a, double b, int i, int n) {
   return n == 1 ? (a + b) / 2 : a + (b - a) * i / (n - 1);
 }
 
+Eigen::Vector3d vector3(const Config& c, const std::string& key, const Eigen::Vector3d& fallback) {
+  if (!c.has(key)) return fallback;
+  const auto v = c.require<std::vector<double>>(key);
+  if (v.size() != 3 || !std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
+    throw c.error_at(key, "must be a list of 3 finite numbers");
+  return {v[0], v[1], v[2]};
+}
+
 }  // namespace
+
+Eigen::Vector3d tool_down_rpy(const Eigen::Vector3d& position) {
+  return {M_PI, 0.0, std::remainder(std::atan2(position.y(), position.x()) + M_PI, 2 * M_PI)};
+}
+
+RobotCalibrationParams load_robot_calibration_params(const Config& c) {
+  RobotCalibrationParams p;
+  const std::string s = "calibrate_robot.";
+  p.box_min = vector3(c, s + "box_min", p.box_min);
+  p.box_max = vector3(c, s + "box_max", p.box_max);
+  if (!(p.box_min.array() <= p.box_max.array()).all())
+    throw c.error_at(s + "box_max", "must be at least box_min on every axis");
+  if (c.has(s + "grid")) {
+    const auto g = c.require<std::vector<int>>(s + "grid");
+    if (g.size() != 3 || g[0] < 1 || g[1] < 1 || g[2] < 2 || g[0] * g[1] * g[2] < 12)
+      throw c.error_at(s + "grid", "must be [nx, ny, nz], nz >= 2, at least 12 points");
+    p.nx = g[0], p.ny = g[1], p.nz = g[2];
+  }
+  if (c.has(s + "tool_rpy")) p.tool_rpy = vector3(c, s + "tool_rpy", {});
+  p.ball_offset = vector3(c, s + "ball_offset", p.ball_offset);
+  p.speed = c.get<double>(s + "speed", p.speed);
+  if (!(p.speed > 0 && p.speed <= 1)) throw c.error_at(s + "speed", "must be in (0, 1]");
+  p.frames_per_stop = c.get<int>(s + "frames_per_stop", p.frames_per_stop);
+  if (p.frames_per_stop < 1) throw c.error_at(s + "frames_per_stop", "must be at least 1");
+  p.settle = c.get<double>(s + "settle", p.settle);
+  if (!(p.settle >= 0)) throw c.error_at(s + "settle", "must be >= 0 seconds");
+  p.max_misses_per_stop = c.get<int>(s + "max_misses_per_stop", p.max_misses_per_stop);
+  if (p.max_misses_per_stop < 1) throw c.error_at(s + "max_misses_per_stop", "must be >= 1");
+  return p;
+}
 
 RobotCalibration::RobotCalibration(const RobotCalibrationParams& p, int64_t first_sequence)
     : params_(p), sequence_(first_sequence - 1) {
@@ -25,7 +64,6 @@ RobotCalibration::RobotCalibration(const RobotCalibrationParams& p, int64_t firs
   if (p.nz < 2)
     throw CalibrationInputError(
         "the grid needs at least 2 heights: the DLT needs points off a plane");
-  const Eigen::Vector3d offset = rotation(p.tool_rpy) * p.ball_offset;
   for (int k = 0; k < p.nz; ++k) {
     for (int j = 0; j < p.ny; ++j) {
       for (int i = 0; i < p.nx; ++i) {
@@ -35,7 +73,8 @@ RobotCalibration::RobotCalibration(const RobotCalibrationParams& p, int64_t firs
         stop.tool = {lerp(p.box_min.x(), p.box_max.x(), ii, p.nx),
                      lerp(p.box_min.y(), p.box_max.y(), j, p.ny),
                      lerp(p.box_min.z(), p.box_max.z(), k, p.nz)};
-        stop.ball = stop.tool + offset;
+        stop.rpy = p.tool_rpy ? *p.tool_rpy : tool_down_rpy(stop.tool);
+        stop.ball = stop.tool + rotation(stop.rpy) * p.ball_offset;
         stops_.push_back(stop);
       }
     }
@@ -46,7 +85,7 @@ RobotCalibration::RobotCalibration(const RobotCalibrationParams& p, int64_t firs
 std::optional<ArmTarget> RobotCalibration::next_target() {
   if (done() || phase_ != Phase::kSend) return std::nullopt;
   phase_ = Phase::kMoving;
-  return ArmTarget{++sequence_, stops_[current_].tool, params_.tool_rpy, params_.speed};
+  return ArmTarget{++sequence_, stops_[current_].tool, stops_[current_].rpy, params_.speed};
 }
 
 void RobotCalibration::on_arm_status(int64_t utime, int64_t last_executed, bool idle) {
@@ -54,6 +93,13 @@ void RobotCalibration::on_arm_status(int64_t utime, int64_t last_executed, bool 
     phase_ = Phase::kSettling;
     arrived_utime_ = utime;
   }
+}
+
+void RobotCalibration::on_arm_rejected(int64_t sequence, const std::string& reason) {
+  if (done() || phase_ != Phase::kMoving || sequence != sequence_) return;
+  stops_[current_].rejected = reason.empty() ? "rejected" : reason;
+  stops_[current_].skipped = true;
+  finish_stop();
 }
 
 void RobotCalibration::on_blob(int camera, int64_t utime, bool found,

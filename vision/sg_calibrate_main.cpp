@@ -3,10 +3,11 @@
 //   sg-calibrate dlt --left left.csv --right right.csv --out cams.yaml
 //        each CSV line X,Y,Z,u,v: a point in the robot frame (m) and its pixel in that camera
 //   sg-calibrate checkerboard --left dirL --right dirR --pattern 9x6 --square 0.025 --out cams.yaml
-//   sg-calibrate robot --out cams.yaml
+//   sg-calibrate robot --out cams.yaml [--box-min X Y Z --box-max X Y Z --grid NX NY NZ]
 //        the arm holds the ball; sg-calibrate moves it (ARM_COMMAND) through a grid of 18
-//        positions, waits for ARM_STATUS to report each arrival, averages BLOB_LEFT/RIGHT there,
-//        and solves the DLT of both cameras in the robot frame
+//        positions (the `calibrate_robot:` section of --config, or the flags), waits for
+//        ARM_STATUS to report each arrival, averages BLOB_LEFT/RIGHT there, and solves the DLT of
+//        both cameras in the robot frame; a stop the arm refuses or the cameras miss is skipped
 //   sg-calibrate register --calibration cams.yaml --points marks.csv --out robot.yaml
 //        each CSV line X,Y,Z,u_left,v_left,u_right,v_right: a point known in the robot frame and
 //        where both cameras see it; the calibration is moved into the robot's frame
@@ -172,7 +173,18 @@ int run_robot(const std::string& url, const sg::vision::RobotCalibrationParams& 
   // Sequence numbers from the clock, so they are newer than any the driver has seen.
   sg::vision::RobotCalibration cal(params, sg::now_utime());
   std::string arm_error;  // handlers run inside LCM's C code: they record, the loop throws
+  int64_t last_rejected = 0;
+  bool connected = false;  // no command before the driver reports its controller connected
   bus.subscribe<stereograsp::arm_status_t>("ARM_STATUS", [&](const auto& s, const auto&) {
+    if (!connected) {
+      if (s.state != stereograsp::arm_status_t::STATE_IDLE) return;
+      connected = true;
+      last_rejected = s.last_rejected_sequence;
+    }
+    if (s.last_rejected_sequence != last_rejected) {
+      last_rejected = s.last_rejected_sequence;
+      cal.on_arm_rejected(s.last_rejected_sequence, s.rejection_reason);
+    }
     if (s.state == stereograsp::arm_status_t::STATE_ERROR ||
         s.state == stereograsp::arm_status_t::STATE_DISCONNECTED)
       arm_error = "the arm reports " + std::string(s.error.empty() ? "an error" : s.error);
@@ -187,6 +199,13 @@ int run_robot(const std::string& url, const sg::vision::RobotCalibrationParams& 
   bus.spin([&] {
     if (!arm_error.empty())
       throw std::runtime_error(arm_error + " at " + cal.progress() + "; nothing written");
+    if (!connected) {
+      if (std::chrono::steady_clock::now() - last_change > std::chrono::duration<double>(timeout_s))
+        throw std::runtime_error("no ARM_STATUS with the arm connected and idle for " +
+                                 std::to_string(static_cast<int>(timeout_s)) +
+                                 " s (is sg-arm-driver running?); nothing written");
+      return true;
+    }
     if (auto t = cal.next_target()) {
       stereograsp::arm_cmd_t cmd{};
       cmd.utime = sg::now_utime();
@@ -214,16 +233,24 @@ int run_robot(const std::string& url, const sg::vision::RobotCalibrationParams& 
   if (!cal.done())
     throw std::runtime_error("interrupted at " + cal.progress() + "; nothing written");
   int skipped = 0;
-  for (const auto& s : cal.stops()) skipped += s.skipped;
+  for (const auto& s : cal.stops()) {
+    skipped += s.skipped;
+    if (!s.rejected.empty()) {
+      spdlog::warn("stop ({:.3f}, {:.3f}, {:.3f}) skipped: the arm refused it: {}", s.tool.x(),
+                   s.tool.y(), s.tool.z(), s.rejected);
+    } else if (s.skipped) {
+      spdlog::warn("stop ({:.3f}, {:.3f}, {:.3f}) skipped: the ball was not seen by both cameras",
+                   s.tool.x(), s.tool.y(), s.tool.z());
+    }
+  }
   sg::vision::StereoCalibration c;
   try {
     c = cal.solve();
   } catch (const CalibrationInputError& e) {
     throw std::runtime_error(e.what());
   }
-  std::printf(
-      "%zu stops (%d skipped: ball not seen); RMS reprojection error left %.3f px, right %.3f px\n",
-      cal.stops().size(), skipped, c.rms_left, c.rms_right);
+  std::printf("%zu stops (%d skipped); RMS reprojection error left %.3f px, right %.3f px\n",
+              cal.stops().size(), skipped, c.rms_left, c.rms_right);
   sg::vision::write_calibration(out, c);
   std::printf("wrote %s (robot frame)\n", out.c_str());
   return 0;
@@ -258,6 +285,8 @@ int main(int argc, char** argv) {
 
   sg::vision::RobotCalibrationParams robot_params;
   double timeout_s = 30;
+  std::vector<double> box_min, box_max, ball_offset, tool_rpy;
+  std::vector<int> grid;
   CLI::App* robot = app.add_subcommand(
       "robot", "Arm-guided: the arm carries the ball through a grid (section 4)");
   robot->add_option("--out", out, "calibration file to write")->required();
@@ -268,6 +297,18 @@ int main(int argc, char** argv) {
   robot->add_option("--width", robot_params.image_width, "image width (px)");
   robot->add_option("--height", robot_params.image_height, "image height (px)");
   robot->add_option("--timeout", timeout_s, "give up after this many seconds without progress");
+  robot->add_option("--box-min", box_min, "grid corner X Y Z, robot frame (m)")->expected(3);
+  robot->add_option("--box-max", box_max, "opposite grid corner X Y Z (m)")->expected(3);
+  robot->add_option("--grid", grid, "points per axis NX NY NZ (NZ >= 2, 12 in all)")->expected(3);
+  robot
+      ->add_option("--ball-offset", ball_offset,
+                   "ball centre from the tool centre point X Y Z, tool frame (m)")
+      ->expected(3);
+  robot
+      ->add_option("--tool-rpy", tool_rpy,
+                   "tool roll pitch yaw at every stop, rad (default: pointing down, pi 0 "
+                   "atan2(Y,X)+pi)")
+      ->expected(3);
 
   CLI::App* reg = app.add_subcommand("register", "Move a calibration into the robot's frame");
   reg->add_option("--calibration", calibration, "calibration in the cameras' frame")->required();
@@ -276,10 +317,35 @@ int main(int argc, char** argv) {
   reg->add_option("--out", out, "calibration file to write")->required();
 
   return sg::run_program(app, argc, argv, [&] {
-    sg::load_common(common);
+    const sg::Config config = sg::load_common(common);
+    if (*robot) {
+      // The config's calibrate_robot section, then the flags given.
+      sg::vision::RobotCalibrationParams p = sg::vision::load_robot_calibration_params(config);
+      auto given = [&](const char* flag) { return robot->count(flag) > 0; };
+      if (given("--frames-per-stop")) p.frames_per_stop = robot_params.frames_per_stop;
+      if (given("--settle")) p.settle = robot_params.settle;
+      if (given("--speed")) p.speed = robot_params.speed;
+      p.image_width = robot_params.image_width;
+      p.image_height = robot_params.image_height;
+      auto vec = [](const std::vector<double>& v) { return Eigen::Vector3d(v[0], v[1], v[2]); };
+      if (!box_min.empty()) p.box_min = vec(box_min);
+      if (!box_max.empty()) p.box_max = vec(box_max);
+      if (!ball_offset.empty()) p.ball_offset = vec(ball_offset);
+      if (!tool_rpy.empty()) p.tool_rpy = vec(tool_rpy);
+      if (!grid.empty()) p.nx = grid[0], p.ny = grid[1], p.nz = grid[2];
+      if (!(p.box_min.array() <= p.box_max.array()).all())
+        throw std::runtime_error("--box-min must be at most --box-max on every axis");
+      if (!(p.speed > 0 && p.speed <= 1)) throw std::runtime_error("--speed must be in (0, 1]");
+      if (!given("--timeout")) timeout_s = config.get<double>("calibrate_robot.timeout", timeout_s);
+      try {
+        sg::vision::RobotCalibration check(p);
+      } catch (const CalibrationInputError& e) {
+        throw std::runtime_error(std::string("--grid: ") + e.what());
+      }
+      return run_robot(common.lcm_url, p, timeout_s, out);
+    }
     if (*dlt) return run_dlt(left, right, width, height, out);
     if (*board) return run_checkerboard(left, right, pattern, square, out);
-    if (*robot) return run_robot(common.lcm_url, robot_params, timeout_s, out);
     return run_register(calibration, points, out);
   });
 }

@@ -176,6 +176,25 @@ TEST(C550Controller, OpenReleases) {
   EXPECT_NEAR(c550.gripper_opening(2.0 + 0.05), 0.08, 1e-12);  // 0.07 -> 0.08 takes 0.05 s
 }
 
+// start_holding powers up with the ball between the fingers, at rest, until the first OPEN; a move
+// keeps it; a ball that does not fit the open gripper is refused.
+TEST(C550Controller, StartHoldingPowersUpWithTheBallInTheGripper) {
+  C550Params params;
+  params.start_holding = true;
+  C550Controller c550 = a465(params);
+  EXPECT_TRUE(c550.holding());
+  EXPECT_NEAR(c550.gripper_opening(0), 0.07, 1e-12);  // 2 * ball radius
+  EXPECT_FALSE(c550.moving(0));
+  ASSERT_TRUE(c550.move_pose({0.45, 0.1, 0.15}, {M_PI, 0, std::atan2(0.1, 0.45) + M_PI}, 1.0));
+  EXPECT_TRUE(c550.holding());
+  EXPECT_NEAR(c550.gripper_opening(c550.settle_time()), 0.07, 1e-12);
+  c550.open(c550.settle_time());
+  EXPECT_FALSE(c550.holding());
+  EXPECT_FALSE(a465().holding());
+  params.ball_radius = 0.045;  // 0.09 m across, the gripper opens 0.08 m
+  EXPECT_THROW(a465(params), std::invalid_argument);
+}
+
 // Segment memory starts at zero and round-trips a write.
 TEST(C550Controller, SegmentMemoryRoundTrips) {
   C550Controller c550 = a465();

@@ -110,5 +110,61 @@ TEST(RobotCalibration, UnseenStopsAreSkippedAndTooFewFail) {
   EXPECT_THROW(RobotCalibration{flat}, CalibrationInputError);
 }
 
+// The default grid is inside the A465's reach tool-down: each wrist centre (0.226 m above the
+// tool centre point) is 0.365 to 0.635 m from the shoulder at z = 0.33 m; the tool points down
+// with yaw atan2(y, x) + pi (joint 6 near zero). (The full inverse kinematics of every stop is
+// checked in tests/integration/robot_calibration_test.cpp.)
+TEST(RobotCalibration, DefaultGridIsWithinReachToolDown) {
+  RobotCalibration cal({});
+  for (const auto& s : cal.stops()) {
+    const Eigen::Vector3d wrist = s.tool + Eigen::Vector3d(0, 0, 0.226);
+    const double reach = (wrist - Eigen::Vector3d(0, 0, 0.33)).norm();
+    EXPECT_GT(reach, 0.375) << s.tool.transpose();
+    EXPECT_LT(reach, 0.625) << s.tool.transpose();
+    EXPECT_GE(s.tool.z(), 0.05);
+    EXPECT_TRUE(s.rpy.isApprox(tool_down_rpy(s.tool)));
+    EXPECT_NEAR(s.rpy.x(), M_PI, 1e-12);
+    EXPECT_NEAR(std::remainder(s.rpy.z() - std::atan2(s.tool.y(), s.tool.x()) - M_PI, 2 * M_PI), 0,
+                1e-12);
+  }
+  EXPECT_NEAR(tool_down_rpy({0.45, 0, 0.1}).z(), M_PI, 1e-12);
+}
+
+// A move the arm refuses skips its stop with the reason and goes on to the next.
+TEST(RobotCalibration, RejectedMoveSkipsTheStop) {
+  RobotCalibration cal({}, 10);
+  const auto first = cal.next_target();
+  ASSERT_TRUE(first);
+  cal.on_arm_rejected(9, "older");  // not the pending command
+  EXPECT_FALSE(cal.stops()[0].skipped);
+  cal.on_arm_rejected(10, "out of reach");
+  EXPECT_TRUE(cal.stops()[0].skipped);
+  EXPECT_EQ(cal.stops()[0].rejected, "out of reach");
+  const auto second = cal.next_target();
+  ASSERT_TRUE(second);
+  EXPECT_EQ(second->sequence, 11);
+  EXPECT_TRUE(second->position.isApprox(cal.stops()[1].tool));
+}
+
+// The calibrate_robot section sets the box, grid, orientation and timing; bad values name the key.
+TEST(RobotCalibration, ParamsFromConfig) {
+  const auto p = load_robot_calibration_params(Config::parse(
+      "calibrate_robot:\n  box_min: [0.40, -0.1, 0.1]\n  box_max: [0.5, 0.1, 0.2]\n"
+      "  grid: [4, 3, 2]\n  tool_rpy: [3.14159, 0, 0]\n  frames_per_stop: 5\n  speed: 0.3\n"));
+  EXPECT_DOUBLE_EQ(p.box_min.x(), 0.40);
+  EXPECT_DOUBLE_EQ(p.box_max.z(), 0.2);
+  EXPECT_EQ(p.nx * p.ny * p.nz, 24);
+  ASSERT_TRUE(p.tool_rpy);
+  EXPECT_EQ(p.frames_per_stop, 5);
+  EXPECT_DOUBLE_EQ(p.speed, 0.3);
+  EXPECT_EQ(RobotCalibration(p).stops().size(), 24u);
+  EXPECT_FALSE(load_robot_calibration_params(Config()).tool_rpy);
+  for (const char* bad :
+       {"calibrate_robot:\n  grid: [3, 3, 1]\n", "calibrate_robot:\n  box_min: [0.6, 0, 0]\n",
+        "calibrate_robot:\n  box_max: [1, 2]\n"}) {
+    EXPECT_THROW(load_robot_calibration_params(Config::parse(bad)), ConfigError) << bad;
+  }
+}
+
 }  // namespace
 }  // namespace sg::vision
