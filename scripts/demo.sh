@@ -3,10 +3,13 @@
 # held and lifted.
 #
 #   scripts/demo.sh [--track-seconds N] [--tag NAME] [--with-images] [--no-prediction]
+#                   [--true-calibration]
 #
 # 1. A one-second check that every stereograsp message type crosses the LCM bus intact.
-# 2. The cameras' calibration (the simulator's own) and the predictor's starting coefficients,
-#    trained offline on the paper's circle (sg-predictor train).
+# 2. Calibration, robot-guided (the paper's section 4): sg-c550-sim starts with the ball in the
+#    gripper, and sg-calibrate moves the arm through a grid while sg-vision finds the ball
+#    (--true-calibration uses the simulator's own cameras instead); and the predictor's starting
+#    coefficients, trained offline on the paper's circle (sg-predictor train).
 # 3. The loop: sg-c550-sim plays the C550 on a pseudo-terminal (0.72-0.84 s per interaction),
 #    sg-arm-driver drives it, sg-camera-sim films the red ball on the paper's path (a 0.15 m
 #    circle at 1 rpm plus a drift along Y) and draws the gripper, sg-vision triangulates the ball,
@@ -23,6 +26,7 @@ cd "$(dirname "$0")/.."
 
 track_seconds=${DEMO_TRACK_SECONDS:-15}
 tag=demo
+true_calibration=0
 with_images=0
 prediction=()
 while [ $# -gt 0 ]; do
@@ -31,7 +35,8 @@ while [ $# -gt 0 ]; do
     --tag) tag="$2"; shift ;;
     --with-images) with_images=1 ;;
     --no-prediction) prediction=(--no-prediction) ;;
-    -h|--help) sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --true-calibration) true_calibration=1 ;;
+    -h|--help) sed -n '2,25p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "demo.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
   shift
@@ -41,6 +46,7 @@ scripts/bootstrap.sh
 if ! scripts/multicast.sh setup; then
   echo "demo: no multicast here; running the demo in a private network namespace" >&2
   args=(--track-seconds "$track_seconds" --tag "$tag" "${prediction[@]}")
+  [ "$true_calibration" -eq 1 ] && args+=(--true-calibration)
   [ "$with_images" -eq 1 ] && args+=(--with-images)
   exec scripts/multicast.sh run "$0" "${args[@]}"
 fi
@@ -76,9 +82,33 @@ wait "$receiver_pid" || status=1
 echo "   $(cat "$session.bus.txt")"
 rm -f "$session.bus.txt"
 
-echo "demo: 2. the cameras' calibration (the simulator's own) and the predictor's coefficients"
+echo "demo: 2. calibration, robot-guided (section 4): the arm carries the ball through a grid"
 "$bin/sg-camera-sim" --snapshot "$session.pair.png" --snapshot-frame 60 \
-  --calibration-out "$session.calibration.yaml" --log-level warn | sed 's/^/   /'
+  --calibration-out "$session.true-calibration.yaml" --log-level warn | sed 's/^/   /'
+calibration="$session.calibration.yaml"
+if [ "$true_calibration" -eq 1 ]; then
+  cp "$session.true-calibration.yaml" "$calibration"
+  echo "   --true-calibration: using the simulator's own cameras"
+else
+  cal_pids=()
+  "$bin/sg-c550-sim" --link "$session.cal-c550" --holding --log-level warn "${url_args[@]}" \
+    > /dev/null 2>&1 &
+  cal_pids+=($!)
+  for _ in $(seq 50); do [ -e "$session.cal-c550" ] && break; sleep 0.1; done
+  "$bin/sg-arm-driver" --device "$session.cal-c550" --log-level warn "${url_args[@]}" &
+  cal_pids+=($!)
+  "$bin/sg-camera-sim" --log-level warn "${url_args[@]}" > /dev/null &
+  cal_pids+=($!)
+  "$bin/sg-vision" --log-level warn "${url_args[@]}" > /dev/null &
+  cal_pids+=($!)
+  pids+=("${cal_pids[@]}")
+  "$bin/sg-calibrate" robot --out "$calibration" --log-level warn "${url_args[@]}" \
+    | sed 's/^/   /' || status=1
+  for p in "${cal_pids[@]}"; do kill -INT "$p" 2>/dev/null || true; done
+  for p in "${cal_pids[@]}"; do wait "$p" 2>/dev/null || true; done
+  pids=("$logger_pid")
+  [ -s "$calibration" ] || { echo "demo: the calibration failed" >&2; exit 1; }
+fi
 # Four minutes of the paper's circle at 4 Hz, t,x,y,z: what Burg's predictors start from.
 awk 'BEGIN { pi = atan2(0, -1); for (k = 0; k < 960; k++) { t = k * 0.25; a = 2 * pi * t / 60;
   printf "%.2f,%.6f,%.6f,0.10\n", t, 0.45 + 0.15 * cos(a), 0.15 * sin(a) } }' > "$session.circle.csv"
@@ -86,14 +116,14 @@ awk 'BEGIN { pi = atan2(0, -1); for (k = 0; k < 960; k++) { t = k * 0.25; a = 2 
 rm -f "$session.circle.csv"
 
 echo "demo: 3. the loop: C550 on a pseudo-terminal, driver, cameras, vision, predictor, grasp"
-"$bin/sg-c550-sim" --link "$session.c550" --log-commands "$session.c550.tsv" --log-level warn \
+"$bin/sg-c550-sim" --link "$session.c550" --log-commands "$session.c550.tsv" \
   "${url_args[@]}" > "$session.c550.txt" 2>&1 &
 pids+=($!)
 for _ in $(seq 50); do [ -e "$session.c550" ] && break; sleep 0.1; done
 "$bin/sg-arm-driver" --device "$session.c550" --log-level warn "${url_args[@]}" \
   > "$session.driver.txt" 2>&1 &
 pids+=($!)
-"$bin/sg-vision" --calibration "$session.calibration.yaml" --log-level warn "${url_args[@]}" \
+"$bin/sg-vision" --calibration "$calibration" --log-level warn "${url_args[@]}" \
   > "$session.vision.txt" &
 pids+=($!)
 "$bin/sg-predictor" --coefficients "$session.coefficients.yaml" --log-level warn \
@@ -101,7 +131,7 @@ pids+=($!)
 pids+=($!)
 "$bin/sg-grasp" "${prediction[@]}" "${url_args[@]}" > "$session.grasp.txt" 2>&1 &
 pids+=($!)
-"$bin/sg-viewer" --record "$session.view.avi" --no-window --calibration "$session.calibration.yaml" \
+"$bin/sg-viewer" --record "$session.view.avi" --no-window --calibration "$calibration" \
   --log-level warn "${url_args[@]}" > "$session.viewer.txt" &
 viewer_pid=$!
 pids+=("$viewer_pid")
@@ -125,6 +155,7 @@ for p in "${pids[@]}"; do [ "$p" = "$logger_pid" ] || wait "$p" 2>/dev/null || t
 pids=("$logger_pid")
 echo "   sg-grasp: $(grep -c . "$session.grasp.txt") state changes (log: $session.grasp.txt)"
 echo "   sg-c550-sim: $(grep -c . "$session.c550.tsv") RAPL-II commands (log: $session.c550.tsv)"
+echo "   the simulator's truth: $(grep -o 'CLOSE at.*' "$session.c550.txt" || echo 'no CLOSE')"
 rm -f "$session.vision.txt" "$session.predictor.txt" "$session.viewer.txt" "$session.cameras.txt"
 
 sleep 0.5
@@ -144,7 +175,7 @@ if [ "$outcome" -ne 0 ]; then
 fi
 cat <<MSG
 demo: done: the ball was grasped and lifted. The session log is $log
-  the cameras' true calibration: $session.calibration.yaml
+  the cameras' calibration: $calibration (the simulator's true one: $session.true-calibration.yaml)
   a stereo pair as the cameras saw it: $session.pair.png
   the grasp state machine's log: $session.grasp.txt; the controller's commands: $session.c550.tsv
   the user interface, recorded: $session.view.avi (frame-to-utime: $session.view.avi.csv)
