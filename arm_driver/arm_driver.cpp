@@ -164,10 +164,8 @@ void ArmDriver::read_joints() {
 void ArmDriver::act(const ArmTarget& target) {
   const auto& timing = settings_.timing;
   if (target.mode == Cmd::MODE_STOP) {
-    link_->command("ABORT", timing.reply_timeout);
-    return;
-  }
-  if (target.moves_arm()) {
+    link_->command("ABORT", timing.reply_timeout);  // then the gripper, if asked (abort: open)
+  } else if (target.moves_arm()) {
     link_->command(rapl::move_joints(to_array(target.joints)), timing.motion_reply);
   } else if (target.mode == Cmd::MODE_HOME) {
     link_->command("READY", timing.motion_reply);
@@ -191,7 +189,7 @@ void ArmDriver::execute(ArmTarget target) {
   motion_done_ = false;
   // A motion delivered and a gripper action not: only the gripper action is tried again.
   const auto requeue_rest = [&] {
-    if (motion_done_ && target.gripper != Cmd::GRIPPER_KEEP && target.mode != Cmd::MODE_STOP) {
+    if (motion_done_ && target.gripper != Cmd::GRIPPER_KEEP) {
       if (target.moves_arm()) update([&](Status&) { commanded_ = target.joints; });
       target.mode = Cmd::MODE_GRIPPER_ONLY;
     }

@@ -209,10 +209,8 @@ void GraspMachine::on_command(GraspCommand command, double standoff, int64_t now
 }
 
 void GraspMachine::on_trajectory(const PredictedPath& path, int64_t source_utime, int64_t now) {
-  if (settings_.use_prediction) {
-    path_ = path;
-    path_source_utime_ = source_utime;
-  }
+  path_ = path;  // without prediction only its liveness counts (fresh_path())
+  path_source_utime_ = source_utime;
   update(now);
 }
 
@@ -320,7 +318,7 @@ std::optional<ArmRequest> GraspMachine::take_request(int64_t now) {
   }
   if (activity == GraspActivity::kGrasping && state == GraspState::kApproaching) {
     std::optional<ArmRequest> r = aim(Kind::kApproach, now);
-    if (r) {
+    if (r && r->gripper == Cmd::GRIPPER_CLOSE) {
       status_.state = GraspState::kGrasping;
       status_.last_action = GraspAction::kCloseHand;
     }
@@ -339,11 +337,22 @@ std::optional<ArmRequest> GraspMachine::aim(Kind kind, int64_t now) {
     refuse("no fresh track of the object");
     return std::nullopt;
   }
-  const bool approach = kind == Kind::kApproach;
-  const Eigen::Vector3d offset(0, 0, approach ? 0.0 : settings_.standoff);
-  const Interception aim =
-      intercept(geometry_, *path, arm_.joints, now, delay_, approach ? delay_ : 0.0, offset,
-                settings_.speed, settings_.interception);
+  bool approach = kind == Kind::kApproach;
+  Eigen::Vector3d offset(0, 0, approach ? 0.0 : settings_.standoff);
+  Interception aim = intercept(geometry_, *path, arm_.joints, now, delay_,
+                               approach ? delay_ : 0.0, offset, settings_.speed,
+                               settings_.interception);
+  // The CLOSE travelling with the approach executes one delay after the motion starts: when the
+  // motion takes longer, the hand would close short of the ball. Close in first, above the ball
+  // as when tracking (still q1), and approach from there.
+  if (approach && aim.ok &&
+      motion_time(geometry_, arm_.joints, aim.joints, settings_.speed) > delay_) {
+    approach = false;
+    kind = Kind::kTrack;
+    offset = Eigen::Vector3d(0, 0, settings_.standoff);
+    aim = intercept(geometry_, *path, arm_.joints, now, delay_, 0.0, offset, settings_.speed,
+                    settings_.interception);
+  }
   if (!aim.ok) {
     refuse("target refused: " + aim.error);
     return std::nullopt;
@@ -513,9 +522,14 @@ std::optional<PredictedPath> GraspMachine::fresh_path(int64_t now, int64_t* sour
     *source_utime = path_source_utime_;
     return path_;
   }
-  if (!measured_ || measured_utime_ < oldest) return std::nullopt;
+  // Without prediction: the last measured position, held. The track is alive while the
+  // measurement is fresh, or while the predictor still tracks the ball (through an occlusion): the
+  // baseline then aims where the ball was last seen, as a system without a predictor would.
+  if (!measured_) return std::nullopt;
+  const bool tracked = path_ && !path_->lost && path_->utime >= oldest;
+  if (measured_utime_ < oldest && !tracked) return std::nullopt;
   *source_utime = measured_utime_;
-  return PredictedPath::hold(*measured_, measured_utime_);
+  return PredictedPath::hold(*measured_, std::max(now, measured_utime_));
 }
 
 // ---------------------------------------------------------------------------------------------

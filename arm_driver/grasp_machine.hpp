@@ -76,7 +76,9 @@
 /// while ArmView.connected.
 ///
 /// --no-prediction (use_prediction = false): the path is PredictedPath::hold(last visible
-/// measurement, its utime), its freshness that of the measurement; trajectories are ignored.
+/// measurement) from now on; the track is fresh while that measurement is, or while the
+/// trajectories (whose points are otherwise ignored) say the predictor still tracks the ball,
+/// e.g. through an occlusion: the baseline aims where the ball was last seen.
 ///
 ///     GraspMachine machine(ArmGeometry::a465(), GraspSettings{}, /*first_sequence=*/1);
 ///     // on each message:                           (now = the shell's clock, us)

@@ -77,8 +77,19 @@ int send(sg::Bus& bus, int8_t command, double standoff, bool wait, double timeou
   c.sender = "sg-grasp-ctl";
   bus.publish("GRASP_COMMAND", c);
   // Done when the machine has moved on: for --wait, until it is idle with the grasp judged.
+  // A command the machine refuses says so at once: "grasp refused: ...", "release ignored ...".
+  const std::string verb = command == Cmd::COMMAND_TRACK     ? "track"
+                           : command == Cmd::COMMAND_GRASP   ? "grasp"
+                           : command == Cmd::COMMAND_RELEASE ? "release"
+                           : command == Cmd::COMMAND_HOME    ? "home"
+                                                             : "abort";
+  const auto refused = [&](const Status& s) {
+    return s.utime >= c.utime &&
+           (s.message.starts_with(verb + " refused") || s.message.starts_with(verb + " ignored"));
+  };
   const auto finished = [&](const Status& s) {
     if (s.utime < c.utime) return false;
+    if (refused(s)) return true;
     if (!wait) return true;
     if (command == Cmd::COMMAND_TRACK) return s.activity == Status::ACTIVITY_TRACKING;
     if (command == Cmd::COMMAND_GRASP)
@@ -89,6 +100,7 @@ int send(sg::Bus& bus, int8_t command, double standoff, bool wait, double timeou
   if (!last) throw std::runtime_error("no GRASP_STATUS: is sg-grasp running on this bus?");
   if (!finished(*last)) throw std::runtime_error("no answer within the time-out");
   print(*last);
+  if (refused(*last)) throw std::runtime_error("sg-grasp: " + last->message);
   if (command == Cmd::COMMAND_GRASP && wait)
     return last->outcome == Status::OUTCOME_SUCCESS ? 0 : 3;
   return 0;

@@ -356,6 +356,23 @@ TEST_F(ArmDriverTest, GripperCloseOpenCycleShowsInStatus) {
   EXPECT_TRUE(bench_->executed_starting("MA ").empty());
 }
 
+// STOP with GRIPPER_OPEN (the grasp machine's abort): ABORT, then OPEN; the hand opens.
+TEST_F(ArmDriverTest, StopWithOpenAbortsThenOpensTheHand) {
+  start();
+  ASSERT_TRUE(connected());
+  driver_->submit(gripper(1, Cmd::GRIPPER_CLOSE));
+  ASSERT_TRUE(done(1));
+  Cmd stop = gripper(2, Cmd::GRIPPER_OPEN);
+  stop.mode = Cmd::MODE_STOP;
+  driver_->submit(stop);
+  ASSERT_TRUE(done(2));
+  EXPECT_EQ(bench_->executed_starting("ABORT"), std::vector<std::string>{"ABORT"});
+  EXPECT_EQ(bench_->executed_starting("OPEN"), std::vector<std::string>{"OPEN"});
+  EXPECT_EQ(status().gripper, Status::GRIPPER_OPEN);
+  EXPECT_TRUE(eventually([&](const Status&) { return bench_->gripper_opening() == 0.08; },
+                         "the fingers open (0.08 m)"));
+}
+
 // A target inside the box but out of reach is rejected in the status with its reason, and no
 // motion reaches the controller (a later gripper command shows the line kept working).
 TEST_F(ArmDriverTest, RejectsUnreachableTargetWithoutSendingIt) {

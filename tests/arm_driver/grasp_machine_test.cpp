@@ -473,6 +473,29 @@ TEST(GraspMachineTest, FullGraspSucceeds) {
 }
 
 // After the lift, a ball measured far from the tool means the grasp failed; the message gives
+// A grasp asked for with the arm far away (turned 150 degrees from the ball): the CLOSE would
+// come before the arm got there, so the machine first closes in above the ball (gripper kept,
+// still q1), then approaches with the CLOSE (q2).
+TEST(GraspMachineTest, FarApproachClosesInFirst) {
+  Rig rig;
+  reach(rig, At::kQ0Idle);
+  rig.arm.joints[0] = 150 * kPi / 180;
+  rig.arm.tool = forward_kinematics(rig.geometry, rig.arm.joints).translation();
+  rig.machine.on_arm_status(rig.arm, rig.now);
+  rig.feed();
+  rig.command(GraspCommand::kGrasp);
+  const std::optional<ArmRequest> closer = rig.take();
+  ASSERT_EQ(kind(closer), Req::kMove) << rig.status().message;
+  EXPECT_EQ(closer->gripper, Cmd::GRIPPER_KEEP);
+  EXPECT_NEAR(closer->position.z(), 0.10 + rig.settings.standoff, 1e-9);
+  EXPECT_EQ(rig.status().state, GraspState::kApproaching);
+  rig.advance(0.8);
+  rig.executed(*closer);
+  rig.feed();
+  const std::optional<ArmRequest> approach = rig.take();
+  ASSERT_EQ(kind(approach), Req::kApproach) << rig.status().message;
+  EXPECT_EQ(rig.status().state, GraspState::kGrasping);
+}
 // the distance.
 TEST(GraspMachineTest, FullGraspFailsWhenTheBallIsNotAtTheTool) {
   Rig rig;
@@ -719,7 +742,7 @@ TEST(GraspMachineTest, NoPredictionAimsAtTheLastMeasurement) {
   Rig rig(settings);
   ASSERT_EQ(kind(rig.take()), Req::kOpen);
   rig.executed(ArmRequest{100});
-  rig.feed();  // ignored
+  rig.feed();  // its points are ignored; it only says the track is alive
   rig.command(GraspCommand::kTrack);
   EXPECT_FALSE(rig.take().has_value());  // nothing measured yet
   const Eigen::Vector3d ball(0.50, 0.10, 0.12);
@@ -742,6 +765,16 @@ TEST(GraspMachineTest, NoPredictionAimsAtTheLastMeasurement) {
   stale.executed(ArmRequest{100});
   stale.command(GraspCommand::kTrack);
   stale.machine.on_measurement(ball, stale.now - 1'100'000);
+  EXPECT_FALSE(stale.take().has_value());
+  // Through an occlusion the predictor still tracks (fresh trajectories): the baseline aims at
+  // where the ball was last seen, however old; a lost track stops it.
+  stale.feed();
+  const std::optional<ArmRequest> occluded = stale.take();
+  ASSERT_EQ(kind(occluded), Req::kMove) << stale.status().message;
+  EXPECT_LT((occluded->position - (ball + Eigen::Vector3d(0, 0, 0.10))).norm(), 1e-9);
+  stale.advance(0.8);
+  stale.executed(*occluded);
+  stale.lose();
   EXPECT_FALSE(stale.take().has_value());
 }
 

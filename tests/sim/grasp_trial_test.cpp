@@ -1,0 +1,77 @@
+#include "sim/grasp_trial.hpp"
+
+#include <gtest/gtest.h>
+
+namespace sg::sim {
+namespace {
+
+/// The paper's ball at 1 rpm, no images (truth + noise), an occlusion over the grasp.
+TrialParams quick_trial() {
+  TrialParams p = paper_trial(3);
+  p.render = false;
+  p.sim.scenario.rpm = 1.0;
+  p.sim.scenario.phase = 0.7;
+  p.grasp_time = 42.0;  // 8 s away from the drift reversal at 50 s
+  p.sim.occlusion.episodes = {{41.0, 3.5}};
+  p.timeout = 10.0;
+  return p;
+}
+
+// With prediction the arm holds the ball after the lift, and the machine judges it so too.
+TEST(GraspTrial, PredictionGraspsTheBallAtOneRpm) {
+  const TrialResult r = run_grasp_trial(quick_trial());
+  EXPECT_TRUE(r.closed);
+  EXPECT_TRUE(r.lifted);
+  EXPECT_TRUE(r.success) << r.message << " miss " << r.miss_distance;
+  EXPECT_LT(r.miss_distance, 0.02);
+  EXPECT_EQ(r.outcome, arm::GraspOutcome::kSuccess) << r.message;
+  EXPECT_TRUE(r.machine_agrees);
+  EXPECT_GT(r.close_time, r.grasp_time);
+  EXPECT_EQ(r.final_state, arm::GraspState::kObjectLifted);
+}
+
+// A ball beyond the arm's reach is never grasped: the machine refuses the targets and says why.
+TEST(GraspTrial, BallOutOfReachIsRefused) {
+  TrialParams p = quick_trial();
+  p.sim.scenario.centre = {1.05, 0.0, 0.10};
+  p.sim.scenario.radius = 0.05;
+  p.sim.scenario.drift_speed = 0.0;
+  p.sim.occlusion.episodes.clear();
+  p.grasp_time = 20.0;
+  p.timeout = 5.0;
+  const TrialResult r = run_grasp_trial(p);
+  EXPECT_FALSE(r.closed);
+  EXPECT_FALSE(r.success);
+  EXPECT_NE(r.outcome, arm::GraspOutcome::kSuccess);
+  EXPECT_NE(r.message.find("refused"), std::string::npos) << r.message;
+  EXPECT_EQ(r.requests, 1);  // only a0, the open hand: no target was ever sent to the arm
+  EXPECT_TRUE(r.machine_agrees);
+}
+
+// The same parameters (rendered frames and vision included) give the same result twice.
+TEST(GraspTrial, SameSeedSameResult) {
+  TrialParams p = quick_trial();
+  p.render = true;
+  p.grasp_time = 16.0;
+  p.sim.occlusion.episodes = {{15.0, 3.0}};
+  p.timeout = 6.0;
+  const TrialResult a = run_grasp_trial(p);
+  const TrialResult b = run_grasp_trial(p);
+  EXPECT_GT(a.visible, 0);
+  EXPECT_EQ(a.success, b.success);
+  EXPECT_EQ(a.closed, b.closed);
+  EXPECT_EQ(a.frames, b.frames);
+  EXPECT_EQ(a.visible, b.visible);
+  EXPECT_EQ(a.requests, b.requests);
+  EXPECT_EQ(a.interactions, b.interactions);
+  EXPECT_EQ(a.message, b.message);
+  EXPECT_EQ(a.end_time, b.end_time);
+  if (a.closed) {
+    EXPECT_EQ(a.close_time, b.close_time);
+    EXPECT_EQ(a.miss_distance, b.miss_distance);
+  }
+  EXPECT_EQ(a.vision_rms, b.vision_rms);
+}
+
+}  // namespace
+}  // namespace sg::sim
