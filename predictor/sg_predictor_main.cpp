@@ -60,6 +60,10 @@ PredictorParams load_params(const sg::Config& c) {
   p.burg.window = c.get<int>("predictor.window", p.burg.window);
   p.burg.remove_mean = c.get<bool>("predictor.remove_mean", p.burg.remove_mean);
   p.burg.online_after = c.get<int>("predictor.online_after", p.burg.online_after);
+  p.gate = c.get<double>("predictor.gate", p.gate);
+  p.gate_patience_us = std::llround(c.get<double>("predictor.gate_patience", 0.5) * 1e6);
+  if (!(p.gate >= 0)) throw c.error_at("predictor.gate", "must be 0 (off) or positive");
+  if (p.gate_patience_us < 0) throw c.error_at("predictor.gate_patience", "must not be negative");
   p.kalman.q = c.get<double>("predictor.kalman_q", p.kalman.q);
   p.kalman.r = c.get<double>("predictor.kalman_r", p.kalman.r);
   if (p.period_us <= 0) throw c.error_at("predictor.period", "must be positive");

@@ -1,5 +1,6 @@
 #include "predictor/trajectory_predictor.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -38,6 +39,7 @@ void TrajectoryPredictor::reset() {
   started_ = false;
   have_seen_ = false;
   occluded_ = 0;
+  gating_since_.reset();
 }
 
 Eigen::Vector3d TrajectoryPredictor::one_step() const {
@@ -75,6 +77,7 @@ Forecast TrajectoryPredictor::emit_sample(int64_t grid, const Eigen::Vector3d& v
   f.occluded_samples = occluded_;
   f.status = status_;
   f.sample = value;
+  last_sample_ = value;
   std::array<std::vector<double>, 3> axis;
   for (int i = 0; i < 3; ++i)
     axis[static_cast<size_t>(i)] = axes_[static_cast<size_t>(i)]->forecast(params_.horizon);
@@ -85,12 +88,37 @@ Forecast TrajectoryPredictor::emit_sample(int64_t grid, const Eigen::Vector3d& v
   return f;
 }
 
-std::vector<Forecast> TrajectoryPredictor::add(const Measurement& m) {
+bool TrajectoryPredictor::outside_gate(const Measurement& m) {
+  // While tracking, or while a run of gated measurements has made the samples fed back.
+  const bool gating =
+      status_ == TrackStatus::kTracking || (gating_since_ && status_ == TrackStatus::kOccluded);
+  if (!(params_.gate > 0) || !m.visible || !gating) return false;
+  // Where the forecast puts the ball at m.utime: between the newest grid sample and the next.
+  const int64_t newest = next_grid_ - params_.period_us;
+  const double s = std::clamp(
+      static_cast<double>(m.utime - newest) / static_cast<double>(params_.period_us), 0.0, 2.0);
+  const Eigen::Vector3d expected = last_sample_ + s * (one_step() - last_sample_);
+  if ((m.position - expected).norm() <= params_.gate) {
+    gating_since_.reset();
+    return false;
+  }
+  if (!gating_since_) gating_since_ = m.utime;
+  if (m.utime - *gating_since_ > params_.gate_patience_us) {  // it really is there
+    gating_since_.reset();
+    return false;
+  }
+  ++gated_;
+  return true;
+}
+
+std::vector<Forecast> TrajectoryPredictor::add(const Measurement& in) {
   std::vector<Forecast> out;
-  if ((m.visible && !m.position.allFinite()) || (started_ && m.utime <= last_utime_)) {
+  if ((in.visible && !in.position.allFinite()) || (started_ && in.utime <= last_utime_)) {
     ++rejected_;
     return out;
   }
+  Measurement m = in;
+  if (outside_gate(m)) m.visible = false;
   last_utime_ = m.utime;
   if (!started_) {
     if (!m.visible) return out;  // nothing to predict from yet

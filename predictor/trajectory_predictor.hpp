@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,12 @@ struct PredictorParams {
   BurgParams burg;              ///< per axis; initial_coefficients below override it
   std::array<std::vector<double>, 3> initial_coefficients;  ///< offline-trained a_1..a_p per axis
   KalmanParams kalman;                                      ///< its period is set from period_us
+  /// While tracking, a visible measurement farther than this from where the forecast puts the
+  /// ball at its time is taken as not seen (a partly hidden ball's centroid, a mismatch): metres,
+  /// 0 turns the gate off ...
+  double gate = 0.010;
+  /// ... unless measurements have disagreed for longer than this: then the ball is where they say.
+  int64_t gate_patience_us = 500'000;
 };
 
 /// One measurement of the ball (OBJECT_POSITION).
@@ -68,6 +75,8 @@ class TrajectoryPredictor {
   std::vector<Forecast> add(const Measurement& m);
 
   uint64_t rejected() const { return rejected_; }
+  /// Visible measurements the gate took as not seen.
+  uint64_t gated() const { return gated_; }
   TrackStatus status() const { return status_; }
   const PredictorParams& params() const { return params_; }
 
@@ -76,6 +85,8 @@ class TrajectoryPredictor {
   Forecast emit_sample(int64_t grid_utime, const Eigen::Vector3d& value, bool measured,
                        int64_t source);
   Eigen::Vector3d one_step() const;
+  /// True when a visible measurement disagrees with the forecast beyond the gate (and patience).
+  bool outside_gate(const Measurement& m);
 
   PredictorParams params_;
   std::array<std::unique_ptr<AxisModel>, 3> axes_;
@@ -89,7 +100,10 @@ class TrajectoryPredictor {
   Eigen::Vector3d seen_position_ = Eigen::Vector3d::Zero();
   int64_t last_real_grid_ = 0;  // last grid sample made from measurements
   Eigen::Vector3d last_real_value_ = Eigen::Vector3d::Zero();
-  int occluded_ = 0;  // consecutive fed-back samples
+  int occluded_ = 0;                                       // consecutive fed-back samples
+  Eigen::Vector3d last_sample_ = Eigen::Vector3d::Zero();  // the newest grid sample
+  uint64_t gated_ = 0;
+  std::optional<int64_t> gating_since_;  // first of the current run of gated measurements
 };
 
 }  // namespace sg::predictor

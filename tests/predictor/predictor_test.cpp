@@ -156,6 +156,46 @@ Eigen::Vector3d circle(double t) {
 
 constexpr int64_t kT0 = 1'700'000'000'000'000;
 
+// The gate: while tracking, one measurement 30 mm off (a partly hidden ball's centroid) is taken
+// as not seen, so the forecast is the same as without it; a ball that really jumped is believed
+// once the measurements have disagreed for longer than the patience.
+TEST(Predictor, GateDropsOutliersButNotARealJump) {
+  PredictorParams p = params_4hz();
+  TrajectoryPredictor gated(p), clean(p);
+  std::vector<Forecast> with_outlier, without;
+  int64_t k = 0;
+  auto at = [](int64_t i) { return kT0 + i * 250'000 / 8; };  // 32 Hz
+  for (; k < 8 * 120; ++k) {                                  // two minutes of tracking
+    const Measurement m{at(k), true, circle(static_cast<double>(at(k) - kT0) * 1e-6)};
+    gated.add(m);
+    clean.add(m);
+  }
+  Measurement outlier{at(k), true, circle(static_cast<double>(at(k) - kT0) * 1e-6)};
+  outlier.position.x() += 0.030;
+  with_outlier = gated.add(outlier);
+  without = clean.add({at(k), false, Eigen::Vector3d::Zero()});
+  EXPECT_EQ(gated.gated(), 1u);
+  ASSERT_EQ(with_outlier.size(), without.size());
+  for (size_t i = 0; i < with_outlier.size(); ++i) {
+    EXPECT_LT((with_outlier[i].positions.back() - without[i].positions.back()).norm(), 1e-12);
+  }
+  // A jump of 50 mm that stays: gated for the patience (0.5 s), then followed.
+  const Eigen::Vector3d jump(0.05, 0, 0);
+  int followed_after = -1;
+  for (int i = 1; i <= 64 && followed_after < 0; ++i) {
+    const int64_t t = at(k + i);
+    for (const Forecast& f : gated.add({t, true, circle((t - kT0) * 1e-6) + jump})) {
+      if (f.status == TrackStatus::kTracking &&
+          (f.sample - (circle((f.utime - kT0) * 1e-6) + jump)).norm() < 0.02) {
+        followed_after = i;
+      }
+    }
+  }
+  EXPECT_GT(followed_after, 8);   // not before the patience of 0.5 s (16 measurements) ...
+  EXPECT_LT(followed_after, 40);  // ... but soon after
+  EXPECT_GT(gated.gated(), 10u);
+}
+
 // Occlusion: fed-back samples carry the track (status OCCLUDED, counted), stay near the truth,
 // and the track recovers when the ball is seen again; after 16 fed-back samples it is lost.
 TEST(Predictor, OcclusionFeedbackRecoveryAndLoss) {
