@@ -32,6 +32,7 @@ packages=(
   libeigen3-dev                                    # linear algebra
   libopencv-dev                                    # images, video files, calibration
   libgtest-dev libgmock-dev libbenchmark-dev       # tests and benchmarks
+  nlohmann-json3-dev                               # sg-report's report.json (and its tests)
   iproute2 util-linux                              # ip and unshare for scripts/multicast.sh
 )
 

@@ -1,0 +1,187 @@
+#include "logger/log_reader.hpp"
+
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <lcm/lcm-cpp.hpp>
+
+namespace sg::logger {
+namespace {
+
+constexpr uint8_t kMagic[4] = {0xED, 0xA1, 0xDA, 0x01};
+constexpr int32_t kMaxChannelLength = 1000;  // LCM refuses longer ones too
+
+int64_t be_int(const uint8_t* p, int n) {
+  uint64_t v = 0;
+  for (int i = 0; i < n; ++i) v = (v << 8) | p[i];
+  return n == 4 ? static_cast<int64_t>(static_cast<int32_t>(v)) : static_cast<int64_t>(v);
+}
+
+/// LCM prints its own line on stderr for each damaged stretch ("Invalid header after log data");
+/// the reader reports the stretch itself, so LCM's line is sent to /dev/null while LCM reads.
+/// glibc's `stderr` is an assignable variable that liblcm's fprintf calls read at call time.
+class QuietLcm {
+ public:
+  QuietLcm() : saved_(stderr) {
+    static FILE* const sink = std::fopen("/dev/null", "w");
+    if (sink != nullptr) stderr = sink;
+  }
+  ~QuietLcm() { stderr = saved_; }
+
+ private:
+  FILE* saved_;
+};
+
+}  // namespace
+
+LogReader::LogReader(const std::string& path) : path_(path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) throw LogReadError(path + ": " + std::strerror(errno));
+  if (S_ISDIR(st.st_mode)) throw LogReadError(path + ": is a directory, not a log");
+  FILE* probe = std::fopen(path.c_str(), "rb");
+  if (probe == nullptr) throw LogReadError(path + ": " + std::strerror(errno));
+  std::fclose(probe);
+  file_size_ = static_cast<int64_t>(st.st_size);
+  log_ = std::make_unique<lcm::LogFile>(path, "r");
+  if (!log_->good()) throw LogReadError(path + ": cannot be opened as an LCM log");
+}
+
+LogReader::~LogReader() = default;
+
+void LogReader::set_progress(std::function<void(int64_t, int64_t)> callback, int64_t every_bytes) {
+  progress_ = std::move(callback);
+  progress_every_ = every_bytes > 0 ? every_bytes : 1;
+  progress_next_ = 0;
+}
+
+void LogReader::report_progress(bool force) {
+  if (!progress_) return;
+  if (!force && end_of_last_ < progress_next_) return;
+  progress_(end_of_last_, file_size_);
+  progress_next_ = end_of_last_ + progress_every_;
+}
+
+void LogReader::add_problem(LogProblem::Kind kind, int64_t offset, int64_t bytes) {
+  ++problem_count_;
+  if (kind == LogProblem::Kind::kSkipped) skipped_bytes_ += bytes;
+  if (kind == LogProblem::Kind::kTruncated) truncated_ = true;
+  if (problems_.size() >= kMaxProblems) return;
+  LogProblem p;
+  p.kind = kind;
+  p.offset = offset;
+  p.bytes = bytes;
+  p.text =
+      kind == LogProblem::Kind::kSkipped
+          ? std::to_string(bytes) + " bytes skipped at offset " + std::to_string(offset)
+          : "truncated at byte " + std::to_string(offset) + " of " + std::to_string(file_size_);
+  problems_.push_back(std::move(p));
+}
+
+bool LogReader::next(LogRecord& out) {
+  if (done_) return false;
+  FILE* f = log_->getFilePtr();
+  const lcm::LogEvent* event = nullptr;
+  {
+    QuietLcm quiet;
+    event = log_->readNextEvent();
+  }
+  if (event == nullptr) {
+    if (end_of_last_ < file_size_ && recover(out)) {
+      ++events_;
+      report_progress(false);
+      return true;
+    }
+    done_ = true;
+    report_progress(true);
+    return false;
+  }
+  const int64_t after = static_cast<int64_t>(ftello(f));
+  const int64_t start =
+      after - kHeaderSize - static_cast<int64_t>(event->channel.size()) - event->datalen;
+  if (start > end_of_last_)
+    add_problem(LogProblem::Kind::kSkipped, end_of_last_, start - end_of_last_);
+  end_of_last_ = after;
+  out.channel = event->channel;
+  out.recv_utime = event->timestamp;
+  out.event_number = event->eventnum;
+  out.data = static_cast<const uint8_t*>(event->data);
+  out.size = event->datalen;
+  out.offset = start;
+  ++events_;
+  report_progress(false);
+  return true;
+}
+
+// LCM stopped short of the end: find the next whole event ourselves, read it, and hand the file
+// back to LCM just after it. The stretch from the last good event to the found one is skipped.
+bool LogReader::recover(LogRecord& out) {
+  FILE* f = log_->getFilePtr();
+  const int64_t skip_start = end_of_last_;
+  int64_t first_overflow = -1;  // a header whose event runs past the end of the file
+  std::vector<uint8_t> chunk(1 << 16);
+  int64_t pos = skip_start;
+  while (pos + 4 <= file_size_) {
+    // The next magic at or after pos.
+    if (fseeko(f, pos, SEEK_SET) != 0) break;
+    const size_t got = std::fread(chunk.data(), 1, chunk.size(), f);
+    if (got < 4) break;
+    int64_t q = -1;
+    for (size_t i = 0; i + 4 <= got; ++i) {
+      if (chunk[i] == kMagic[0] && std::memcmp(&chunk[i], kMagic, 4) == 0) {
+        q = pos + static_cast<int64_t>(i);
+        break;
+      }
+    }
+    if (q < 0) {
+      pos += static_cast<int64_t>(got) - 3;
+      continue;
+    }
+    uint8_t header[kHeaderSize];
+    if (q + kHeaderSize > file_size_) {
+      if (first_overflow < 0) first_overflow = q;
+      pos = q + 1;
+      continue;
+    }
+    fseeko(f, q, SEEK_SET);
+    if (std::fread(header, 1, kHeaderSize, f) != kHeaderSize) break;
+    const int64_t channel_length = be_int(header + 20, 4);
+    const int64_t data_length = be_int(header + 24, 4);
+    if (channel_length <= 0 || channel_length > kMaxChannelLength || data_length < 0) {
+      pos = q + 1;  // a magic inside garbage or data, not a header
+      continue;
+    }
+    const int64_t end = q + kHeaderSize + channel_length + data_length;
+    if (end > file_size_) {
+      if (first_overflow < 0) first_overflow = q;
+      pos = q + 1;
+      continue;
+    }
+    buffer_.resize(static_cast<size_t>(channel_length + data_length));
+    if (std::fread(buffer_.data(), 1, buffer_.size(), f) != buffer_.size()) break;
+    if (q > skip_start) add_problem(LogProblem::Kind::kSkipped, skip_start, q - skip_start);
+    out.channel.assign(reinterpret_cast<const char*>(buffer_.data()),
+                       static_cast<size_t>(channel_length));
+    out.recv_utime = be_int(header + 12, 8);
+    out.event_number = be_int(header + 4, 8);
+    out.data = buffer_.data() + channel_length;
+    out.size = static_cast<int>(data_length);
+    out.offset = q;
+    end_of_last_ = end;
+    fseeko(f, end, SEEK_SET);  // LCM goes on from here
+    return true;
+  }
+  // No whole event after the last good one.
+  if (first_overflow >= 0) {
+    if (first_overflow > skip_start)
+      add_problem(LogProblem::Kind::kSkipped, skip_start, first_overflow - skip_start);
+    add_problem(LogProblem::Kind::kTruncated, first_overflow, file_size_ - first_overflow);
+  } else if (file_size_ > skip_start) {
+    add_problem(LogProblem::Kind::kSkipped, skip_start, file_size_ - skip_start);
+  }
+  end_of_last_ = file_size_;
+  return false;
+}
+
+}  // namespace sg::logger
