@@ -16,8 +16,9 @@
 #    sg-predictor forecasts it 4 s ahead, sg-grasp tracks it with the arm at a stand-off
 #    (sg-grasp-ctl track), then grasps and lifts it (sg-grasp-ctl grasp), aiming where the ball
 #    will be when the slow controller gets there; sg-viewer records the user interface.
-# 4. The outcome, and what the log holds. The stock lcm-logger records the session into logs/
-#    (camera images only with --with-images: they are large).
+# 4. The outcome, and the bus check's messages found intact in the log. The stock lcm-logger
+#    records the session into logs/ (camera images only with --with-images: they are large).
+# 5. sg-report on the session: report.md, report.json, a CSV per channel and the plots.
 #
 # The bus is LCM's default (or $LCM_DEFAULT_URL), so `scripts/spy.sh` in another terminal shows
 # the channels while the demo runs.
@@ -36,7 +37,7 @@ while [ $# -gt 0 ]; do
     --with-images) with_images=1 ;;
     --no-prediction) prediction=(--no-prediction) ;;
     --true-calibration) true_calibration=1 ;;
-    -h|--help) sed -n '2,25p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
     *) echo "demo.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
   shift
@@ -163,8 +164,10 @@ kill -INT "$logger_pid"
 wait "$logger_pid" || true
 pids=()
 
-echo "demo: 4. what the log holds:"
-"$bin/sg-bus-check" verify-log "$log" --count 100 | sed 's/^/   /' || status=1
+echo "demo: 4. the bus check's messages in the log:"
+"$bin/sg-bus-check" verify-log "$log" --count 100 | tail -1 | sed 's/^/   /' || status=1
+echo "demo: 5. the session report (sg-report):"
+"$bin/sg-report" "$log" --out "$session.report" --quiet | sed 's/^/   /' || status=1
 if [ "$status" -ne 0 ]; then
   echo "demo: FAILED (log kept: $log)" >&2
   exit 1
@@ -179,6 +182,9 @@ demo: done: the ball was grasped and lifted. The session log is $log
   a stereo pair as the cameras saw it: $session.pair.png
   the grasp state machine's log: $session.grasp.txt; the controller's commands: $session.c550.tsv
   the user interface, recorded: $session.view.avi (frame-to-utime: $session.view.avi.csv)
+  the report: $session.report/report.md, with plots $session.report/xy.png (figure 5),
+    y_time.png (figure 6), latency.png, arm.png, and a CSV per channel in $session.report/csv/
+  re-run it:   scripts/replay.sh $log   (offline, from the stage the log starts at)
   replay it:   lcm-logplayer $log
   inspect it:  scripts/spy.sh (while replaying or during a demo)
 MSG
