@@ -17,7 +17,8 @@
 namespace sg {
 
 /// Every stereograsp message type, for code that handles all of them alike (bus checks, log
-/// readers, tests). Add a type here when adding a .lcm file.
+/// readers, tests). Add a type here when adding a .lcm file, and its fields to
+/// common/message_fields.hpp.
 using MessageTypes = std::tuple<stereograsp::image_t, stereograsp::blob_t, stereograsp::point3_t,
                                 stereograsp::trajectory_t, stereograsp::arm_cmd_t,
                                 stereograsp::arm_status_t, stereograsp::grasp_command_t,

@@ -5,9 +5,12 @@
 #include <filesystem>
 #include <stdexcept>
 #include <system_error>
+#include <type_traits>
 #include <unordered_map>
 #include <utility>
+#include <vector>
 
+#include "common/message_fields.hpp"
 #include "common/message_types.hpp"
 
 namespace sg::logger {
@@ -16,16 +19,16 @@ namespace {
 // One message's cells, with their column names.
 class Row {
  public:
-  void add_int(std::string name, int64_t value) { add(std::move(name), std::to_string(value)); }
+  void add_int(std::string name, int64_t value) { push(std::move(name), std::to_string(value)); }
 
   void add_double(std::string name, double value) {
     if (std::isnan(value)) {
-      add(std::move(name), "nan");
+      push(std::move(name), "nan");
       return;
     }
     char buffer[40];
     std::snprintf(buffer, sizeof buffer, "%.17g", value);
-    add(std::move(name), buffer);
+    push(std::move(name), buffer);
   }
 
   void add_string(std::string name, const std::string& value) {
@@ -35,161 +38,35 @@ class Row {
       cell += c;
     }
     cell += '"';
-    add(std::move(name), std::move(cell));
+    push(std::move(name), std::move(cell));
   }
 
-  template <class T, size_t N>
-  void add_ints(const std::string& name, const T (&values)[N]) {
-    for (size_t i = 0; i < N; ++i) add_int(name + "_" + std::to_string(i), values[i]);
-  }
-
-  template <size_t N>
-  void add_doubles(const std::string& name, const double (&values)[N]) {
-    for (size_t i = 0; i < N; ++i) add_double(name + "_" + std::to_string(i), values[i]);
-  }
-
-  template <size_t N, size_t M>
-  void add_doubles(const std::string& name, const double (&values)[N][M]) {
-    for (size_t i = 0; i < N; ++i) add_doubles(name + "_" + std::to_string(i), values[i]);
+  /// One field, as common/message_fields.hpp names it: numbers and booleans as they are,
+  /// strings quoted, arrays flattened with _i suffixes; byte arrays (image data) left out.
+  template <class T>
+  void add(const std::string& name, const T& value) {
+    if constexpr (std::is_same_v<T, std::vector<uint8_t>>) {
+      return;  // the bytes themselves are left out (the message's size field stays)
+    } else if constexpr (std::is_same_v<T, std::string>) {
+      add_string(name, value);
+    } else if constexpr (std::is_floating_point_v<T>) {
+      add_double(name, value);
+    } else if constexpr (std::is_arithmetic_v<T>) {
+      add_int(name, static_cast<int64_t>(value));
+    } else {  // a fixed array or a vector of anything else
+      for (size_t i = 0; i < std::size(value); ++i) add(name + "_" + std::to_string(i), value[i]);
+    }
   }
 
   std::vector<std::string> names;
   std::vector<std::string> cells;
 
  private:
-  void add(std::string name, std::string cell) {
+  void push(std::string name, std::string cell) {
     names.push_back(std::move(name));
     cells.push_back(std::move(cell));
   }
 };
-
-using stereograsp::arm_cmd_t;
-using stereograsp::arm_status_t;
-using stereograsp::blob_t;
-using stereograsp::grasp_command_t;
-using stereograsp::grasp_status_t;
-using stereograsp::image_t;
-using stereograsp::point3_t;
-using stereograsp::sim_arm_state_t;
-using stereograsp::trajectory_t;
-
-void flatten(const image_t& m, Row& row) {
-  row.add_int("utime", m.utime);
-  row.add_int("camera", m.camera);
-  row.add_int("frame_number", m.frame_number);
-  row.add_int("width", m.width);
-  row.add_int("height", m.height);
-  row.add_int("row_stride", m.row_stride);
-  row.add_int("pixel_format", m.pixel_format);
-  row.add_int("size", m.size);  // the bytes themselves are left out
-}
-
-void flatten(const blob_t& m, Row& row) {
-  row.add_int("utime", m.utime);
-  row.add_int("camera", m.camera);
-  row.add_int("frame_number", m.frame_number);
-  row.add_int("found", m.found);
-  row.add_int("mode", m.mode);
-  row.add_doubles("centroid", m.centroid);
-  row.add_double("area", m.area);
-  row.add_double("major_axis", m.major_axis);
-  row.add_double("minor_axis", m.minor_axis);
-  row.add_double("orientation", m.orientation);
-  row.add_doubles("major_axis_ends", m.major_axis_ends);
-  row.add_doubles("minor_axis_ends", m.minor_axis_ends);
-  row.add_doubles("bounding_box", m.bounding_box);
-  row.add_ints("search_window", m.search_window);
-  row.add_int("num_regions", m.num_regions);
-  row.add_int("misses", m.misses);
-}
-
-void flatten(const point3_t& m, Row& row) {
-  row.add_int("utime", m.utime);
-  row.add_int("visible", m.visible);
-  row.add_doubles("position", m.position);
-  row.add_doubles("position_sigma", m.position_sigma);
-  row.add_double("reprojection_error", m.reprojection_error);
-  row.add_int("seen_by", m.seen_by);
-  row.add_int("flags", m.flags);
-}
-
-void flatten(const trajectory_t& m, Row& row) {
-  row.add_int("utime", m.utime);
-  row.add_int("source_utime", m.source_utime);
-  row.add_int("start_utime", m.start_utime);
-  row.add_int("period_us", m.period_us);
-  row.add_int("num_points", m.num_points);
-  for (size_t i = 0; i < m.position.size(); ++i) {
-    const std::string prefix = "position_" + std::to_string(i) + "_";
-    for (size_t j = 0; j < m.position[i].size(); ++j) {
-      row.add_double(prefix + std::to_string(j), m.position[i][j]);
-    }
-  }
-  row.add_int("occluded_samples", m.occluded_samples);
-  row.add_int("status", m.status);
-  row.add_int("model", m.model);
-  row.add_int("model_order", m.model_order);
-}
-
-void flatten(const arm_cmd_t& m, Row& row) {
-  row.add_int("utime", m.utime);
-  row.add_int("source_utime", m.source_utime);
-  row.add_int("target_utime", m.target_utime);
-  row.add_int("sequence", m.sequence);
-  row.add_int("mode", m.mode);
-  row.add_doubles("position", m.position);
-  row.add_doubles("orientation", m.orientation);
-  row.add_doubles("joints", m.joints);
-  row.add_int("gripper", m.gripper);
-  row.add_double("speed", m.speed);
-  row.add_string("sender", m.sender);
-}
-
-void flatten(const arm_status_t& m, Row& row) {
-  row.add_int("utime", m.utime);
-  row.add_int("state", m.state);
-  row.add_doubles("joints", m.joints);
-  row.add_doubles("tool_position", m.tool_position);
-  row.add_doubles("tool_orientation", m.tool_orientation);
-  row.add_int("gripper", m.gripper);
-  row.add_int("last_received_sequence", m.last_received_sequence);
-  row.add_int("last_executed_sequence", m.last_executed_sequence);
-  row.add_int("last_rejected_sequence", m.last_rejected_sequence);
-  row.add_string("rejection_reason", m.rejection_reason);
-  row.add_int("source_utime", m.source_utime);
-  row.add_double("interaction_time", m.interaction_time);
-  row.add_double("speed", m.speed);
-  row.add_string("error", m.error);
-}
-
-void flatten(const grasp_command_t& m, Row& row) {
-  row.add_int("utime", m.utime);
-  row.add_int("sequence", m.sequence);
-  row.add_int("command", m.command);
-  row.add_double("standoff", m.standoff);
-  row.add_string("sender", m.sender);
-}
-
-void flatten(const grasp_status_t& m, Row& row) {
-  row.add_int("utime", m.utime);
-  row.add_int("source_utime", m.source_utime);
-  row.add_int("state", m.state);
-  row.add_int("activity", m.activity);
-  row.add_int("last_action", m.last_action);
-  row.add_doubles("target", m.target);
-  row.add_int("target_utime", m.target_utime);
-  row.add_int("outcome", m.outcome);
-  row.add_string("message", m.message);
-}
-
-void flatten(const sim_arm_state_t& m, Row& row) {
-  row.add_int("utime", m.utime);
-  row.add_doubles("joints", m.joints);
-  row.add_doubles("tool_position", m.tool_position);
-  row.add_doubles("tool_orientation", m.tool_orientation);
-  row.add_double("gripper_opening", m.gripper_opening);
-  row.add_int("holding_object", m.holding_object);
-}
 
 // Every type of sg::MessageTypes: its fingerprint, name, and exact decoding into a Row.
 struct TypeEntry {
@@ -202,7 +79,7 @@ template <class T>
 bool decode_into(const uint8_t* data, int size, Row& row) {
   T message{};  // value-initialised: GCC cannot see that decode() sets every field
   if (message.decode(data, 0, size) != size) return false;
-  flatten(message, row);
+  visit_fields(message, row);
   return true;
 }
 

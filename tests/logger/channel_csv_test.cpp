@@ -295,7 +295,7 @@ void expect_round_trip(test::SampleKind kind) {
   ASSERT_TRUE(writer.write(out, -42, bytes.data(), static_cast<int>(bytes.size())))
       << T::getTypeName();
   Leaves expected;
-  test::visit_fields(message, expected);
+  sg::visit_fields(message, expected);
   const auto rows = parse_csv(out.str());
   ASSERT_EQ(rows.size(), 2u) << T::getTypeName();
   ASSERT_EQ(rows[0].size(), expected.leaves.size() + 1) << T::getTypeName();

@@ -8,6 +8,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "common/message_fields.hpp"
 #include "common/message_types.hpp"
 
 namespace sg::test {
@@ -68,65 +69,6 @@ class FieldDump {
 
   std::map<std::string, std::string> fields_;
 };
-
-// clang-format off
-/// Each type's fields, in any order, for a visitor with `template <class T> add(name, T& value)`.
-#define SG_FIELD(f) v.add(#f, m.f)
-
-template <class V>
-inline void visit_fields(stereograsp::image_t& m, V& v) {
-  SG_FIELD(utime); SG_FIELD(camera); SG_FIELD(frame_number); SG_FIELD(width); SG_FIELD(height);
-  SG_FIELD(row_stride); SG_FIELD(pixel_format); SG_FIELD(size); SG_FIELD(data);
-}
-template <class V>
-inline void visit_fields(stereograsp::blob_t& m, V& v) {
-  SG_FIELD(utime); SG_FIELD(camera); SG_FIELD(frame_number); SG_FIELD(found); SG_FIELD(mode);
-  SG_FIELD(centroid); SG_FIELD(area); SG_FIELD(major_axis); SG_FIELD(minor_axis);
-  SG_FIELD(orientation); SG_FIELD(major_axis_ends); SG_FIELD(minor_axis_ends);
-  SG_FIELD(bounding_box); SG_FIELD(search_window); SG_FIELD(num_regions); SG_FIELD(misses);
-}
-template <class V>
-inline void visit_fields(stereograsp::point3_t& m, V& v) {
-  SG_FIELD(utime); SG_FIELD(visible); SG_FIELD(position); SG_FIELD(position_sigma);
-  SG_FIELD(reprojection_error); SG_FIELD(seen_by); SG_FIELD(flags);
-}
-template <class V>
-inline void visit_fields(stereograsp::trajectory_t& m, V& v) {
-  SG_FIELD(utime); SG_FIELD(source_utime); SG_FIELD(start_utime); SG_FIELD(period_us);
-  SG_FIELD(num_points); SG_FIELD(position); SG_FIELD(occluded_samples); SG_FIELD(status);
-  SG_FIELD(model); SG_FIELD(model_order);
-}
-template <class V>
-inline void visit_fields(stereograsp::arm_cmd_t& m, V& v) {
-  SG_FIELD(utime); SG_FIELD(source_utime); SG_FIELD(target_utime); SG_FIELD(sequence);
-  SG_FIELD(mode); SG_FIELD(position); SG_FIELD(orientation); SG_FIELD(joints); SG_FIELD(gripper);
-  SG_FIELD(speed); SG_FIELD(sender);
-}
-template <class V>
-inline void visit_fields(stereograsp::arm_status_t& m, V& v) {
-  SG_FIELD(utime); SG_FIELD(state); SG_FIELD(joints); SG_FIELD(tool_position);
-  SG_FIELD(tool_orientation); SG_FIELD(gripper); SG_FIELD(last_received_sequence);
-  SG_FIELD(last_executed_sequence); SG_FIELD(last_rejected_sequence); SG_FIELD(rejection_reason);
-  SG_FIELD(source_utime); SG_FIELD(interaction_time); SG_FIELD(speed); SG_FIELD(error);
-}
-template <class V>
-inline void visit_fields(stereograsp::grasp_command_t& m, V& v) {
-  SG_FIELD(utime); SG_FIELD(sequence); SG_FIELD(command); SG_FIELD(standoff); SG_FIELD(sender);
-}
-template <class V>
-inline void visit_fields(stereograsp::grasp_status_t& m, V& v) {
-  SG_FIELD(utime); SG_FIELD(source_utime); SG_FIELD(state); SG_FIELD(activity);
-  SG_FIELD(last_action); SG_FIELD(target); SG_FIELD(target_utime); SG_FIELD(outcome);
-  SG_FIELD(message);
-}
-template <class V>
-inline void visit_fields(stereograsp::sim_arm_state_t& m, V& v) {
-  SG_FIELD(utime); SG_FIELD(joints); SG_FIELD(tool_position); SG_FIELD(tool_orientation);
-  SG_FIELD(gripper_opening); SG_FIELD(holding_object);
-}
-
-// clang-format on
-#undef SG_FIELD
 
 /// The dump of one message, headed by its type name and fingerprint.
 template <class Message>
