@@ -167,7 +167,7 @@ pids=()
 echo "demo: 4. the bus check's messages in the log:"
 "$bin/sg-bus-check" verify-log "$log" --count 100 | tail -1 | sed 's/^/   /' || status=1
 echo "demo: 5. the session report (sg-report):"
-"$bin/sg-report" "$log" --out "$session.report" --quiet | sed 's/^/   /' || status=1
+"$bin/sg-report" "$log" --out "$session.report" | sed 's/^/   /' || status=1
 if [ "$status" -ne 0 ]; then
   echo "demo: FAILED (log kept: $log)" >&2
   exit 1
