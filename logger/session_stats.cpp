@@ -539,8 +539,10 @@ struct SessionStats::Impl {
       ++arm.errors;
     last_arm_state = s.state;
     have_arm = true;
+    // A driver that has not reached its controller yet knows no joints: no tool position.
     const Vec3 p(s.tool_position[0], s.tool_position[1], s.tool_position[2]);
-    if (plots && finite3(p)) plots->arm_actual.add(t(s.utime), p);
+    const bool known = s.state != stereograsp::arm_status_t::STATE_DISCONNECTED;
+    if (plots && known && finite3(p)) plots->arm_actual.add(t(s.utime), p);
   }
 
   void on_grasp_status(int64_t recv, const stereograsp::grasp_status_t& g) {
