@@ -24,6 +24,7 @@
 #include "arm_driver/rapl.hpp"
 #include "sim/c550_controller.hpp"
 #include "sim/c550_emulator.hpp"
+#include "tests/support/arm_commands.hpp"
 
 namespace sg::arm {
 namespace {
@@ -204,20 +205,10 @@ std::unique_ptr<ByteStream> Bench::open() {
   return std::make_unique<EmulatedLine>(*this, *emulators_.back());
 }
 
-/// A tool-down (roll pi) Cartesian move with yaw pi/2, which keeps joint 6 near +90 degrees.
+/// A tool-down move with yaw pi/2, which keeps joint 6 near +90 degrees.
 Cmd move_to(int64_t sequence, double x, double y, double z) {
-  Cmd c{};
-  c.sequence = sequence;
-  c.mode = Cmd::MODE_CARTESIAN;
-  c.position[0] = x;
-  c.position[1] = y;
-  c.position[2] = z;
-  c.orientation[0] = kPi;
-  c.orientation[2] = kPi / 2;
-  c.gripper = Cmd::GRIPPER_KEEP;
-  c.speed = 0.5;
+  Cmd c = test::tool_down_move(sequence, x, y, z, kPi / 2);
   c.source_utime = 1000 + sequence;
-  c.sender = "test";
   return c;
 }
 

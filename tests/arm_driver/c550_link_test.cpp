@@ -21,6 +21,7 @@
 #include "arm_driver/units.hpp"
 #include "sim/c550_controller.hpp"
 #include "sim/c550_emulator.hpp"
+#include "tests/support/arm_commands.hpp"
 
 namespace sg::arm {
 namespace {
@@ -151,16 +152,7 @@ LinkTiming test_timing() {
   return timing;
 }
 
-/// The message of the exception `f` throws as E, or "<nothing thrown>".
-template <typename E, typename F>
-std::string message_of(F&& f) {
-  try {
-    f();
-  } catch (const E& e) {
-    return e.what();
-  }
-  return "<nothing thrown>";
-}
+using test::message_of;
 
 testing::AssertionResult contains(const std::string& text, const std::string& part) {
   if (text.find(part) != std::string::npos) return testing::AssertionSuccess();

@@ -11,6 +11,8 @@
 #include <numbers>
 #include <string>
 
+#include "tests/support/arm_commands.hpp"
+
 namespace sg::arm {
 namespace {
 
@@ -28,22 +30,10 @@ Joints ready_joints() {
   return q;
 }
 
-/// A tool-down Cartesian command (roll pi) with yaw pi/2, which keeps joint 6 at +90 degrees for
-/// targets on the X axis, away from its +-180 degree limit.
+/// A tool-down Cartesian command with yaw pi/2, which keeps joint 6 at +90 degrees for targets on
+/// the X axis, away from its +-180 degree limit.
 Cmd cartesian(int64_t sequence, double x, double y, double z) {
-  Cmd c{};
-  c.sequence = sequence;
-  c.mode = Cmd::MODE_CARTESIAN;
-  c.position[0] = x;
-  c.position[1] = y;
-  c.position[2] = z;
-  c.orientation[0] = kPi;
-  c.orientation[1] = 0;
-  c.orientation[2] = kPi / 2;
-  c.gripper = Cmd::GRIPPER_KEEP;
-  c.speed = 0.5;
-  c.sender = "test";
-  return c;
+  return test::tool_down_move(sequence, x, y, z, kPi / 2);
 }
 
 /// A joint command to `q` (radians).

@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "tests/support/arm_commands.hpp"
+
 namespace sg::arm {
 namespace {
 
@@ -91,16 +93,7 @@ Bytes read_port(SerialPort& port, size_t count) {
   return bytes;
 }
 
-/// The message of the exception `f` throws as E, or "<nothing thrown>".
-template <typename E, typename F>
-std::string message_of(F&& f) {
-  try {
-    f();
-  } catch (const E& e) {
-    return e.what();
-  }
-  return "<nothing thrown>";
-}
+using test::message_of;
 
 class SerialPortTest : public ::testing::Test {
  protected:

@@ -15,6 +15,7 @@
 #include "common/clock.hpp"
 #include "common/message_types.hpp"
 #include "tests/integration/multicast_guard.hpp"
+#include "tests/support/arm_commands.hpp"
 #include "tests/support/subprocess.hpp"
 
 namespace sg::test {
@@ -58,17 +59,8 @@ std::string first_repeat(const std::vector<std::string>& lines) {
 
 /// A tool-down Cartesian move; yaw = azimuth + pi keeps joint 6 away from its +-180 deg limit.
 arm_cmd_t move_to(int64_t sequence, double x, double y, double z) {
-  arm_cmd_t c{};
+  arm_cmd_t c = tool_down_move(sequence, x, y, z, std::atan2(y, x) + kPi);
   c.utime = now_utime();
-  c.sequence = sequence;
-  c.mode = arm_cmd_t::MODE_CARTESIAN;
-  c.position[0] = x;
-  c.position[1] = y;
-  c.position[2] = z;
-  c.orientation[0] = kPi;
-  c.orientation[2] = std::atan2(y, x) + kPi;
-  c.gripper = arm_cmd_t::GRIPPER_KEEP;
-  c.speed = 0.5;
   c.sender = "arm_test";
   return c;
 }
