@@ -15,7 +15,8 @@
 #    circle at 1 rpm plus a drift along Y) and draws the gripper, sg-vision triangulates the ball,
 #    sg-predictor forecasts it 4 s ahead, sg-grasp tracks it with the arm at a stand-off
 #    (sg-grasp-ctl track), then grasps and lifts it (sg-grasp-ctl grasp), aiming where the ball
-#    will be when the slow controller gets there; sg-viewer records the user interface.
+#    will be when the slow controller gets there, while a panel hides it from the cameras (the
+#    paper's figure 6); sg-viewer records the user interface.
 # 4. The outcome, and the bus check's messages found intact in the log. The stock lcm-logger
 #    records the session into logs/ (camera images only with --with-images: they are large).
 # 5. sg-report on the session: report.md, report.json, a CSV per channel and the plots.
@@ -137,7 +138,11 @@ pids+=($!)
 viewer_pid=$!
 pids+=("$viewer_pid")
 sleep 1
-"$bin/sg-camera-sim" --log-level warn "${url_args[@]}" > "$session.cameras.txt" &
+# A panel hides the ball from the cameras while the hand closes on it (from 1 s before the grasp
+# is asked for, for 3 s): the arm is aimed by the prediction alone, as in the paper's figure 6.
+occlusion_start=$(( 3 + track_seconds - 1 ))
+"$bin/sg-camera-sim" --occlusion "$occlusion_start:3" --log-level warn "${url_args[@]}" \
+  > "$session.cameras.txt" &
 cameras_pid=$!
 pids+=("$cameras_pid")
 sleep 3
