@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <utility>
 
@@ -339,9 +340,8 @@ std::optional<ArmRequest> GraspMachine::aim(Kind kind, int64_t now) {
   }
   bool approach = kind == Kind::kApproach;
   Eigen::Vector3d offset(0, 0, approach ? 0.0 : settings_.standoff);
-  Interception aim = intercept(geometry_, *path, arm_.joints, now, delay_,
-                               approach ? delay_ : 0.0, offset, settings_.speed,
-                               settings_.interception);
+  Interception aim = intercept(geometry_, *path, arm_.joints, now, delay_, approach ? delay_ : 0.0,
+                               offset, settings_.speed, settings_.interception);
   // The CLOSE travelling with the approach executes one delay after the motion starts: when the
   // motion takes longer, the hand would close short of the ball. Close in first, above the ball
   // as when tracking (still q1), and approach from there.
@@ -457,6 +457,7 @@ void GraspMachine::answered(bool failed, const std::string& how, int64_t now) {
       } else {
         status_.state = GraspState::kObjectLifted;
         judging_ = true;
+        nearest_ = std::numeric_limits<double>::infinity();
         lifted_utime_ = now;
         stopped_utime_.reset();
       }
@@ -488,19 +489,22 @@ void GraspMachine::update(int64_t now) {
 
 void GraspMachine::judge(int64_t now) {
   if (!judging_) return;
-  // From when a measurement says where the ball is with the arm at rest.
+  // From when a measurement says where the ball is with the arm at rest; over a window, since one
+  // sighting can be another red thing while the gripper or a panel hides the ball.
   const int64_t rest = stopped_utime_ ? *stopped_utime_ : lifted_utime_ + to_us(kSettleTimeout);
   if (now < rest) return;
   if (measured_ && measured_utime_ >= rest) {
-    const double distance = (*measured_ - arm_.tool).norm();
-    const bool held = distance <= settings_.success_distance;
-    status_.outcome = held ? GraspOutcome::kSuccess : GraspOutcome::kFailed;
-    set_message(std::string(held ? "object held" : "object not held") + ": ball " +
-                fixed(distance, 3) + " m from the tool (limit " +
-                fixed(settings_.success_distance, 3) + " m)");
-  } else if (now > rest + to_us(settings_.max_trajectory_age)) {
+    nearest_ = std::min(nearest_, (*measured_ - arm_.tool).norm());
+  }
+  const std::string limit = " (limit " + fixed(settings_.success_distance, 3) + " m)";
+  if (nearest_ <= settings_.success_distance) {
+    status_.outcome = GraspOutcome::kSuccess;
+    set_message("object held: ball " + fixed(nearest_, 3) + " m from the tool" + limit);
+  } else if (now > rest + to_us(settings_.judge_time)) {
     status_.outcome = GraspOutcome::kFailed;
-    set_message("ball not seen after the lift");
+    set_message(std::isfinite(nearest_) ? "object not held: ball " + fixed(nearest_, 3) +
+                                              " m from the tool at the nearest" + limit
+                                        : "ball not seen after the lift");
   } else {
     return;
   }

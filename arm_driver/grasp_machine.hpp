@@ -55,11 +55,12 @@
 ///    to q1, which tries again.
 ///  - q2 -> q3 when the arm reports it executed; then a3: straight up by `lift` from the target,
 ///    same orientation (z clamped to the workspace box).
-///  - q3 -> q4 when the lift is executed. The outcome is judged on the first measurement
-///    captured after the arm reported it had stopped (or kSettleTimeout after the lift, if it
-///    never does): success when the ball is within success_distance of the arm's tool, failed
-///    (the message gives the distance) otherwise, or failed "ball not seen after the lift" when
-///    no visible measurement comes within max_trajectory_age. Activity idle. (A measurement
+///  - q3 -> q4 when the lift is executed. The outcome is judged on the measurements captured
+///    after the arm reported it had stopped (or kSettleTimeout after the lift, if it never does):
+///    success as soon as one puts the ball within success_distance of the arm's tool; failed
+///    (the message gives the nearest distance) when none has within judge_time, or "ball not
+///    seen after the lift" when none was visible. (The gripper or a panel may hide the held ball
+///    for a while, and vision then finds other red things.) Activity idle. (A measurement
 ///    from before the lift says nothing: the ball sits at the tool whether it was grasped or
 ///    not.)
 ///  - Lost track in q1 (the trajectory is lost, or none newer than max_trajectory_age): the
@@ -174,8 +175,9 @@ struct GraspSettings {
   double speed = 0.5;               ///< fraction of the joint speed limits (the paper's 50 %)
   double max_trajectory_age = 1.0;  ///< s: a trajectory older than now - this gives no command
   double success_distance = 0.05;   ///< m: after the lift, a ball this close to the tool = success
-  double default_delay = 0.78;      ///< s per controller command until one is measured
-  bool use_prediction = true;       ///< false: aim at the last measurement (PredictedPath::hold)
+  double judge_time = 3.0;      ///< s after the arm stops: no sighting that close by then = failed
+  double default_delay = 0.78;  ///< s per controller command until one is measured
+  bool use_prediction = true;   ///< false: aim at the last measurement (PredictedPath::hold)
   InterceptionSettings interception;
 };
 
@@ -289,7 +291,8 @@ class GraspMachine {
   Eigen::Vector3d approach_rpy_ = Eigen::Vector3d::Zero();
 
   bool judging_ = false;
-  int64_t lifted_utime_ = 0;              ///< when the lift was reported executed
+  double nearest_ = 0;        ///< m: the nearest sighting to the tool since the arm came to rest
+  int64_t lifted_utime_ = 0;  ///< when the lift was reported executed
   std::optional<int64_t> stopped_utime_;  ///< first status after it with the arm at rest
 };
 

@@ -43,6 +43,7 @@ sg::arm::GraspSettings load_settings(const sg::Config& c, const Options& o) {
   s.backoff = c.get<double>("grasp.backoff", s.backoff);
   s.max_trajectory_age = c.get<double>("grasp.max_trajectory_age", s.max_trajectory_age);
   s.success_distance = c.get<double>("grasp.success_distance", s.success_distance);
+  s.judge_time = c.get<double>("grasp.judge_time", s.judge_time);
   s.default_delay = c.get<double>("grasp.default_delay", s.default_delay);
   s.use_prediction = !o.no_prediction && c.get<bool>("grasp.use_prediction", true);
   auto& i = s.interception;
@@ -54,6 +55,7 @@ sg::arm::GraspSettings load_settings(const sg::Config& c, const Options& o) {
   if (!(s.speed > 0 && s.speed <= 1)) throw c.error_at("grasp.speed", "in (0, 1]");
   if (!(s.lift > 0 && s.lift <= 0.5)) throw c.error_at("grasp.lift", "in (0, 0.5] m");
   if (!(s.max_trajectory_age > 0)) throw c.error_at("grasp.max_trajectory_age", "positive");
+  if (!(s.judge_time > 0)) throw c.error_at("grasp.judge_time", "positive");
   if (!(i.wrist_min < i.wrist_max)) throw c.error_at("grasp.wrist_min", "below wrist_max");
   return s;
 }
