@@ -7,6 +7,7 @@
 #include <string>
 #include <utility>
 
+#include "common/grasp_names.hpp"
 #include "stereograsp/arm_cmd_t.hpp"
 
 namespace sg::arm {
@@ -36,66 +37,13 @@ constexpr std::size_t kRememberedRequests = 16;
 
 }  // namespace
 
-const char* to_string(GraspState state) {
-  switch (state) {
-    case GraspState::kHandOpened:
-      return "q0 hand opened";
-    case GraspState::kApproaching:
-      return "q1 approaching";
-    case GraspState::kGrasping:
-      return "q2 grasping";
-    case GraspState::kHandClosed:
-      return "q3 hand closed";
-    case GraspState::kObjectLifted:
-      return "q4 object lifted";
-  }
-  return "unknown";
-}
-
+const char* to_string(GraspState state) { return grasp_state_name(static_cast<int>(state)); }
 const char* to_string(GraspActivity activity) {
-  switch (activity) {
-    case GraspActivity::kIdle:
-      return "idle";
-    case GraspActivity::kTracking:
-      return "tracking";
-    case GraspActivity::kGrasping:
-      return "grasping";
-    case GraspActivity::kHoming:
-      return "homing";
-    case GraspActivity::kBackingOff:
-      return "backing off";
-  }
-  return "unknown";
+  return grasp_activity_name(static_cast<int>(activity));
 }
-
-const char* to_string(GraspAction action) {
-  switch (action) {
-    case GraspAction::kNone:
-      return "none";
-    case GraspAction::kOpenHand:
-      return "a0 open hand";
-    case GraspAction::kApproachObject:
-      return "a1 approach object";
-    case GraspAction::kCloseHand:
-      return "a2 close hand";
-    case GraspAction::kLiftObject:
-      return "a3 lift object";
-  }
-  return "unknown";
-}
-
+const char* to_string(GraspAction action) { return grasp_action_name(static_cast<int>(action)); }
 const char* to_string(GraspOutcome outcome) {
-  switch (outcome) {
-    case GraspOutcome::kNone:
-      return "none";
-    case GraspOutcome::kSuccess:
-      return "success";
-    case GraspOutcome::kFailed:
-      return "failed";
-    case GraspOutcome::kAborted:
-      return "aborted";
-  }
-  return "unknown";
+  return grasp_outcome_name(static_cast<int>(outcome));
 }
 
 const char* to_string(GraspCommand command) {

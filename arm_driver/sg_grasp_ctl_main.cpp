@@ -14,6 +14,7 @@
 
 #include "common/bus.hpp"
 #include "common/clock.hpp"
+#include "common/grasp_names.hpp"
 #include "common/program.hpp"
 #include "common/shutdown.hpp"
 #include "stereograsp/grasp_command_t.hpp"
@@ -24,23 +25,9 @@ namespace {
 using Cmd = stereograsp::grasp_command_t;
 using Status = stereograsp::grasp_status_t;
 
-const char* state_name(int8_t s) {
-  static const char* names[] = {"q0 hand opened", "q1 approaching", "q2 grasping", "q3 hand closed",
-                                "q4 object lifted"};
-  return s >= 0 && s <= 4 ? names[s] : "?";
-}
-const char* activity_name(int8_t a) {
-  static const char* names[] = {"idle", "tracking", "grasping", "homing", "backing off"};
-  return a >= 0 && a <= 4 ? names[a] : "?";
-}
-const char* outcome_name(int8_t o) {
-  static const char* names[] = {"none", "success", "failed", "aborted"};
-  return o >= 0 && o <= 3 ? names[o] : "?";
-}
-
 void print(const Status& s) {
-  std::printf("%-17s %-12s outcome %-8s", state_name(s.state), activity_name(s.activity),
-              outcome_name(s.outcome));
+  std::printf("%-17s %-12s outcome %-8s", sg::grasp_state_name(s.state),
+              sg::grasp_activity_name(s.activity), sg::grasp_outcome_name(s.outcome));
   if (std::isfinite(s.target[0])) {
     std::printf(" target (%.3f, %.3f, %.3f) m", s.target[0], s.target[1], s.target[2]);
   }

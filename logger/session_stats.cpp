@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <optional>
 
+#include "common/grasp_names.hpp"
 #include "common/message_types.hpp"
 
 namespace sg::logger {
@@ -57,24 +58,6 @@ bool decode_exact(const uint8_t* data, int size, T& message) {
   return message.decode(data, 0, size) == size;
 }
 
-const char* state_name(int s) {
-  static const char* names[] = {"q0 hand opened", "q1 approaching", "q2 grasping", "q3 hand closed",
-                                "q4 object lifted"};
-  return s >= 0 && s <= 4 ? names[s] : "unknown state";
-}
-const char* activity_name(int a) {
-  static const char* names[] = {"idle", "tracking", "grasping", "homing", "backing off"};
-  return a >= 0 && a <= 4 ? names[a] : "unknown";
-}
-const char* action_name(int a) {
-  static const char* names[] = {"a0 open hand", "a1 approach object", "a2 close hand",
-                                "a3 lift object"};
-  return a >= 0 && a <= 3 ? names[a] : (a == -1 ? "none" : "unknown");
-}
-const char* outcome_name(int o) {
-  static const char* names[] = {"none", "success", "failed", "aborted"};
-  return o >= 0 && o <= 3 ? names[o] : "unknown";
-}
 const char* command_name(int c) {
   static const char* names[] = {"?", "track", "grasp", "release", "abort", "home"};
   return c >= 1 && c <= 5 ? names[c] : "unknown";
@@ -560,10 +543,10 @@ struct SessionStats::Impl {
       GraspEvent e;
       e.t_s = t(g.utime);
       e.utime = g.utime;
-      e.state = state_name(g.state);
-      e.activity = activity_name(g.activity);
-      e.action = action_name(g.last_action);
-      e.outcome = outcome_name(g.outcome);
+      e.state = grasp_state_name(g.state);
+      e.activity = grasp_activity_name(g.activity);
+      e.action = grasp_action_name(g.last_action);
+      e.outcome = grasp_outcome_name(g.outcome);
       e.message = g.message;
       if (plots && plots->events.size() < kMaxEvents) {
         std::string label = e.state;
