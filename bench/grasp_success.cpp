@@ -1,5 +1,5 @@
 // How often the whole system grasps the moving ball (issue 8): many grasp trials in simulated
-// time, in one process, through the live system's libraries (sim/grasp_trial.hpp: rendered frames,
+// time, in one process, through the live system's libraries (system/grasp_trial.hpp: rendered frames,
 // vision, the Burg predictor at 4 Hz, the grasp state machine, the C550 model behind the driver's
 // timing). Per trial, drawn from --seed: the ball's phase, circle radius 0.10-0.15 m, speed
 // 0.5-2 rpm, Y drift 0-0.01 m/s (the paper's back-and-forth, reversing every 20 s), the grasp
@@ -26,7 +26,7 @@
 #include <thread>
 #include <vector>
 
-#include "sim/grasp_trial.hpp"
+#include "system/grasp_trial.hpp"
 
 namespace {
 
@@ -46,10 +46,10 @@ struct Options {
 };
 
 /// Trial `index`'s draw: the same for both modes.
-sg::sim::TrialParams draw_trial(const Options& o, int index) {
+sg::system::TrialParams draw_trial(const Options& o, int index) {
   std::mt19937_64 rng(o.seed * 1'000'003ULL + static_cast<uint64_t>(index));
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  sg::sim::TrialParams p = sg::sim::paper_trial(rng());
+  sg::system::TrialParams p = sg::system::paper_trial(rng());
   auto& s = p.sim.scenario;
   s.phase = 2 * std::numbers::pi * u(rng);
   s.radius = 0.10 + 0.05 * u(rng);
@@ -76,7 +76,7 @@ double percentile(std::vector<double> v, double q) {
 
 struct ModeSummary {
   const char* name;
-  std::vector<sg::sim::TrialResult> results;
+  std::vector<sg::system::TrialResult> results;
   double seconds = 0;
 };
 
@@ -87,9 +87,9 @@ ModeSummary run_mode(const Options& o, bool prediction) {
   const auto start = std::chrono::steady_clock::now();
   auto worker = [&] {
     for (int i = next++; i < o.trials; i = next++) {
-      sg::sim::TrialParams p = draw_trial(o, i);
+      sg::system::TrialParams p = draw_trial(o, i);
       p.grasp.use_prediction = prediction;
-      m.results[static_cast<size_t>(i)] = sg::sim::run_grasp_trial(p);
+      m.results[static_cast<size_t>(i)] = sg::system::run_grasp_trial(p);
     }
   };
   std::vector<std::thread> pool;
@@ -107,9 +107,9 @@ ModeSummary run_mode(const Options& o, bool prediction) {
       std::printf(
           "%5d %4.2f %5.3f %5.4f %7.2f %8.2f %4s %4s %8.1f %7.1f %6.0f %6.2f %7.2f  %s / %s%s\n", i,
           p.sim.scenario.rpm, p.sim.scenario.radius, p.sim.scenario.drift_speed, r.grasp_time,
-          r.close_time, r.success ? "yes" : "no", sg::arm::to_string(r.outcome),
+          r.close_time, r.success ? "yes" : "no", sg::grasp::to_string(r.outcome),
           r.miss_distance * 1e3, r.aim_error * 1e3, r.timing_error * 1e3, r.track_age,
-          r.vision_rms * 1e3, sg::arm::to_string(r.final_state), r.message.c_str(),
+          r.vision_rms * 1e3, sg::grasp::to_string(r.final_state), r.message.c_str(),
           r.arm_rejection.empty() ? "" : (" [arm: " + r.arm_rejection + "]").c_str());
     }
   }

@@ -1,4 +1,4 @@
-#include "sim/grasp_trial.hpp"
+#include "system/grasp_trial.hpp"
 
 #include <algorithm>
 #include <array>
@@ -10,10 +10,11 @@
 #include <stdexcept>
 
 #include "arm_driver/command_validator.hpp"
-#include "arm_driver/grasp_messages.hpp"
+#include "grasp/grasp_messages.hpp"
 #include "vision/triangulation.hpp"
 
-namespace sg::sim {
+namespace sg::system {
+using namespace sg::sim;  // NOLINT: the trial is rewritten on the product's parts
 namespace {
 
 using Cmd = stereograsp::arm_cmd_t;
@@ -53,7 +54,7 @@ class Trial {
 
   TrialResult run() {
     result_.grasp_time = p_.grasp_time;
-    machine_.on_command(arm::GraspCommand::kTrack, 0.0, utime_at(0));
+    machine_.on_command(grasp::GraspCommand::kTrack, 0.0, utime_at(0));
     pump(0);
     int64_t frame = 0, tick = 0, shell = 0;
     bool grasp_sent = false;
@@ -79,15 +80,15 @@ class Trial {
       if (t_frame <= t) capture(frame++, t);
       if (t_grasp <= t) {
         grasp_sent = true;
-        machine_.on_command(arm::GraspCommand::kGrasp, 0.0, utime_at(t));
-        if (machine_.status().activity != arm::GraspActivity::kGrasping) {
+        machine_.on_command(grasp::GraspCommand::kGrasp, 0.0, utime_at(t));
+        if (machine_.status().activity != grasp::GraspActivity::kGrasping) {
           result_.refused = true;
           break;
         }
       }
       if (t_shell <= t) ++shell;
       pump(t);
-      if (grasp_sent && !outcome_seen_ && machine_.status().outcome != arm::GraspOutcome::kNone) {
+      if (grasp_sent && !outcome_seen_ && machine_.status().outcome != grasp::GraspOutcome::kNone) {
         outcome_seen_ = true;
         stop_at = std::min(stop_at, t + p_.settle_after_outcome);
       }
@@ -156,7 +157,7 @@ class Trial {
     const predictor::Measurement m{utime, measured.has_value(),
                                    measured.value_or(Eigen::Vector3d::Zero())};
     for (const predictor::Forecast& f : predictor_.add(m)) {
-      arm::PredictedPath path;
+      grasp::PredictedPath path;
       path.utime = f.utime;
       path.start_utime = f.utime + f.period_us;
       path.period_us = f.period_us;
@@ -172,7 +173,7 @@ class Trial {
 
   void pump(double t) {
     for (int i = 0; i < 4; ++i) {  // one request in flight (abort aside): never more than a few
-      std::optional<arm::ArmRequest> r = machine_.take_request(utime_at(t));
+      std::optional<grasp::ArmRequest> r = machine_.take_request(utime_at(t));
       if (!r) return;
       submit(*r, t);
     }
@@ -206,9 +207,9 @@ class Trial {
   void poll(double t) { read_joints(t); }
 
   /// A request from the machine: validated on arrival, then the latest-wins slot.
-  void submit(const arm::ArmRequest& r, double t) {
+  void submit(const grasp::ArmRequest& r, double t) {
     ++result_.requests;
-    const Cmd c = arm::to_arm_cmd(r, utime_at(t));
+    const Cmd c = grasp::to_arm_cmd(r, utime_at(t));
     const arm::Joints reference =
         pending_ && pending_->moves_arm() ? pending_->joints : commanded_.value_or(polled_);
     arm::ValidationResult v = validator_.validate(c, reference);
@@ -332,13 +333,13 @@ class Trial {
   }
 
   TrialResult finish() {
-    const arm::GraspStatusView& s = machine_.status();
+    const grasp::GraspStatusView& s = machine_.status();
     result_.end_time = now_;
     result_.outcome = s.outcome;
     result_.final_state = s.state;
     result_.message = s.message;
     result_.success = controller_.holding() && result_.lifted;
-    result_.machine_success = s.outcome == arm::GraspOutcome::kSuccess;
+    result_.machine_success = s.outcome == grasp::GraspOutcome::kSuccess;
     result_.machine_agrees = result_.machine_success == result_.success;
     if (vision_n_ > 0) result_.vision_rms = std::sqrt(vision_sq_ / vision_n_);
     return result_;
@@ -353,13 +354,13 @@ class Trial {
   StereoFrame frame_;
   C550Controller controller_;
   arm::CommandValidator validator_;
-  arm::GraspMachine machine_;
+  grasp::GraspMachine machine_;
   predictor::TrajectoryPredictor predictor_;
   std::mt19937_64 noise_rng_;
   std::optional<Eigen::Vector3d> dropped_at_;
 
   // The driver model.
-  arm::ArmView view_;
+  grasp::ArmView view_;
   arm::Joints polled_ = arm::Joints::Zero();
   std::optional<arm::Joints> commanded_;
   std::optional<arm::ArmTarget> pending_;
@@ -373,7 +374,7 @@ class Trial {
   double end_time_ = kNever;
   double next_poll_ = 0;
   double change_at_ = kNever;
-  std::map<int64_t, arm::ArmRequest> requests_;
+  std::map<int64_t, grasp::ArmRequest> requests_;
 
   double now_ = 0;
   double last_seen_ = std::nan("");
@@ -397,4 +398,4 @@ TrialParams paper_trial(uint64_t seed) {
 
 TrialResult run_grasp_trial(const TrialParams& params) { return Trial(params).run(); }
 
-}  // namespace sg::sim
+}  // namespace sg::system

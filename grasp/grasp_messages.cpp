@@ -1,8 +1,8 @@
-#include "arm_driver/grasp_messages.hpp"
+#include "grasp/grasp_messages.hpp"
 
 #include <cmath>
 
-namespace sg::arm {
+namespace sg::grasp {
 
 stereograsp::arm_cmd_t to_arm_cmd(const ArmRequest& r, int64_t utime, const std::string& sender) {
   stereograsp::arm_cmd_t c{};
@@ -73,4 +73,4 @@ std::optional<PredictedPath> path_from(const stereograsp::trajectory_t& m, std::
   return p;
 }
 
-}  // namespace sg::arm
+}  // namespace sg::grasp

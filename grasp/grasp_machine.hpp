@@ -95,10 +95,13 @@
 #include <optional>
 #include <string>
 
-#include "arm_driver/interception.hpp"
+#include "grasp/interception.hpp"
 #include "arm_driver/kinematics.hpp"
 
-namespace sg::arm {
+namespace sg::grasp {
+
+using arm::ArmGeometry;
+using arm::Joints;
 
 /// Figure 4's states (grasp_status_t Q*).
 enum class GraspState : int8_t {
@@ -296,4 +299,4 @@ class GraspMachine {
   std::optional<int64_t> stopped_utime_;  ///< first status after it with the arm at rest
 };
 
-}  // namespace sg::arm
+}  // namespace sg::grasp

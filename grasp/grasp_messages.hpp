@@ -1,7 +1,7 @@
 #pragma once
 
 /// The grasp machine's values as LCM messages and back: the one place sg-grasp and the in-process
-/// trials (sim/grasp_trial.hpp) convert, so both speak to the arm alike.
+/// trials (system/grasp_trial.hpp) convert, so both speak to the arm alike.
 ///
 ///     machine.on_arm_status(arm_view_of(arm_status), now);
 ///     if (auto path = path_from(trajectory, &why)) machine.on_trajectory(*path, ...);
@@ -11,14 +11,14 @@
 #include <optional>
 #include <string>
 
-#include "arm_driver/grasp_machine.hpp"
-#include "arm_driver/interception.hpp"
+#include "grasp/grasp_machine.hpp"
+#include "grasp/interception.hpp"
 #include "stereograsp/arm_cmd_t.hpp"
 #include "stereograsp/arm_status_t.hpp"
 #include "stereograsp/grasp_status_t.hpp"
 #include "stereograsp/trajectory_t.hpp"
 
-namespace sg::arm {
+namespace sg::grasp {
 
 /// An ArmRequest as the ARM_COMMAND it stands for; `utime` is the message time of the decision.
 stereograsp::arm_cmd_t to_arm_cmd(const ArmRequest& request, int64_t utime,
@@ -36,4 +36,4 @@ stereograsp::grasp_status_t to_grasp_status(const GraspStatusView& view, int64_t
 std::optional<PredictedPath> path_from(const stereograsp::trajectory_t& trajectory,
                                        std::string* why = nullptr);
 
-}  // namespace sg::arm
+}  // namespace sg::grasp

@@ -1,8 +1,8 @@
-#include "sim/grasp_trial.hpp"
+#include "system/grasp_trial.hpp"
 
 #include <gtest/gtest.h>
 
-namespace sg::sim {
+namespace sg::system {
 namespace {
 
 /// The paper's ball at 1 rpm, no images (truth + noise), an occlusion over the grasp.
@@ -24,10 +24,10 @@ TEST(GraspTrial, PredictionGraspsTheBallAtOneRpm) {
   EXPECT_TRUE(r.lifted);
   EXPECT_TRUE(r.success) << r.message << " miss " << r.miss_distance;
   EXPECT_LT(r.miss_distance, 0.02);
-  EXPECT_EQ(r.outcome, arm::GraspOutcome::kSuccess) << r.message;
+  EXPECT_EQ(r.outcome, grasp::GraspOutcome::kSuccess) << r.message;
   EXPECT_TRUE(r.machine_agrees);
   EXPECT_GT(r.close_time, r.grasp_time);
-  EXPECT_EQ(r.final_state, arm::GraspState::kObjectLifted);
+  EXPECT_EQ(r.final_state, grasp::GraspState::kObjectLifted);
 }
 
 // A ball beyond the arm's reach is never grasped: the machine refuses the targets and says why.
@@ -42,7 +42,7 @@ TEST(GraspTrial, BallOutOfReachIsRefused) {
   const TrialResult r = run_grasp_trial(p);
   EXPECT_FALSE(r.closed);
   EXPECT_FALSE(r.success);
-  EXPECT_NE(r.outcome, arm::GraspOutcome::kSuccess);
+  EXPECT_NE(r.outcome, grasp::GraspOutcome::kSuccess);
   EXPECT_NE(r.message.find("refused"), std::string::npos) << r.message;
   EXPECT_EQ(r.requests, 1);  // only a0, the open hand: no target was ever sent to the arm
   EXPECT_TRUE(r.machine_agrees);
@@ -74,4 +74,4 @@ TEST(GraspTrial, SameSeedSameResult) {
 }
 
 }  // namespace
-}  // namespace sg::sim
+}  // namespace sg::system

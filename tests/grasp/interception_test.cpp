@@ -1,8 +1,8 @@
-// Interception (arm_driver/interception.hpp): interpolating the predicted path, the leaned
+// Interception (grasp/interception.hpp): interpolating the predicted path, the leaned
 // approach pose that keeps the wrist in the A465's comfortable shell, and the arrival-time fixed
 // point on synthetic circular trajectories with a known controller delay.
 
-#include "arm_driver/interception.hpp"
+#include "grasp/interception.hpp"
 
 #include <gtest/gtest.h>
 
@@ -12,8 +12,15 @@
 
 #include "arm_driver/kinematics.hpp"
 
-namespace sg::arm {
+namespace sg::grasp {
 namespace {
+
+using arm::IkResult;
+using arm::pose_from_xyz_rpy;
+using arm::rpy_from_rotation;
+using arm::solve_nearest;
+using arm::forward_kinematics;
+using arm::motion_time;
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kDeg = kPi / 180.0;
@@ -384,4 +391,4 @@ TEST(InterceptTest, RefusesWithoutConvergenceOrWithABadSpeed) {
 }
 
 }  // namespace
-}  // namespace sg::arm
+}  // namespace sg::grasp

@@ -12,8 +12,8 @@
 #include <cmath>
 #include <map>
 
-#include "arm_driver/grasp_machine.hpp"
-#include "arm_driver/grasp_messages.hpp"
+#include "grasp/grasp_machine.hpp"
+#include "grasp/grasp_messages.hpp"
 #include "common/bus.hpp"
 #include "common/clock.hpp"
 #include "common/program.hpp"
@@ -27,7 +27,7 @@
 
 namespace {
 
-using sg::arm::GraspMachine;
+using sg::grasp::GraspMachine;
 
 struct Options {
   bool no_prediction = false;
@@ -35,8 +35,8 @@ struct Options {
 };
 
 /// The grasp settings from `grasp.*` in the config, flags winning.
-sg::arm::GraspSettings load_settings(const sg::Config& c, const Options& o) {
-  sg::arm::GraspSettings s;
+sg::grasp::GraspSettings load_settings(const sg::Config& c, const Options& o) {
+  sg::grasp::GraspSettings s;
   s.standoff = o.standoff >= 0 ? o.standoff : c.get<double>("grasp.standoff", s.standoff);
   s.speed = o.speed > 0 ? o.speed : c.get<double>("grasp.speed", s.speed);
   s.lift = c.get<double>("grasp.lift", s.lift);
@@ -61,14 +61,14 @@ sg::arm::GraspSettings load_settings(const sg::Config& c, const Options& o) {
 }
 
 /// The fields a person watches: a change of any is published and logged at once.
-std::string summary(const sg::arm::GraspStatusView& v) {
+std::string summary(const sg::grasp::GraspStatusView& v) {
   return std::string(to_string(v.state)) + ", " + to_string(v.activity) + ", last " +
          to_string(v.last_action) + ", outcome " + to_string(v.outcome) +
          (v.message.empty() ? "" : ": " + v.message);
 }
 
 int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
-        const sg::arm::GraspSettings& settings, double status_rate) {
+        const sg::grasp::GraspSettings& settings, double status_rate) {
   sg::install_shutdown_handlers();
   sg::Bus bus(url);
   GraspMachine machine(geometry, settings, sg::now_utime());
@@ -77,7 +77,7 @@ int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
   bus.subscribe<stereograsp::trajectory_t>("OBJECT_TRAJECTORY", [&](const auto& m, const auto&) {
     trajectory_utime = m.utime;
     std::string why;
-    if (auto path = sg::arm::path_from(m, &why)) {
+    if (auto path = sg::grasp::path_from(m, &why)) {
       machine.on_trajectory(*path, m.source_utime, sg::now_utime());
     } else {
       spdlog::warn("OBJECT_TRAJECTORY at {}: {}; ignored", m.utime, why);
@@ -88,7 +88,7 @@ int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
     machine.on_measurement(m.visible && p.allFinite() ? std::optional(p) : std::nullopt, m.utime);
   });
   bus.subscribe<stereograsp::arm_status_t>("ARM_STATUS", [&](const auto& m, const auto&) {
-    machine.on_arm_status(sg::arm::arm_view_of(m), sg::now_utime());
+    machine.on_arm_status(sg::grasp::arm_view_of(m), sg::now_utime());
   });
   bus.subscribe<stereograsp::grasp_command_t>("GRASP_COMMAND", [&](const auto& m, const auto&) {
     auto [it, fresh] = last_command.try_emplace(m.sender, m.sequence);
@@ -108,7 +108,7 @@ int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
                    m.standoff);
       return;
     }
-    machine.on_command(static_cast<sg::arm::GraspCommand>(m.command), m.standoff, sg::now_utime());
+    machine.on_command(static_cast<sg::grasp::GraspCommand>(m.command), m.standoff, sg::now_utime());
   });
   spdlog::info("grasping {} prediction", settings.use_prediction ? "with" : "WITHOUT");
   const auto period = std::chrono::duration<double>(1.0 / status_rate);
@@ -120,12 +120,12 @@ int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
     if (auto request = machine.take_request(now)) {
       // utime: the message time of the decision, the newest trajectory's (the clock's before one).
       bus.publish("ARM_COMMAND",
-                  sg::arm::to_arm_cmd(*request, trajectory_utime ? trajectory_utime : now));
+                  sg::grasp::to_arm_cmd(*request, trajectory_utime ? trajectory_utime : now));
     }
     const std::string s = summary(machine.status());
     const auto t = std::chrono::steady_clock::now();
     if (s != last_summary || t >= next) {
-      bus.publish("GRASP_STATUS", sg::arm::to_grasp_status(machine.status(), now));
+      bus.publish("GRASP_STATUS", sg::grasp::to_grasp_status(machine.status(), now));
       if (s != last_summary) spdlog::info("{}", s);
       last_summary = s;
       next = t + std::chrono::duration_cast<std::chrono::steady_clock::duration>(period);

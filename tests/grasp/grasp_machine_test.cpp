@@ -4,7 +4,7 @@
 // in flight, the delay learning and the --no-prediction mode. Fresh trajectories are a synthetic
 // circle (centre (0.45, 0, 0.10) m, radius 0.15 m, 1 rpm as in the paper) sampled at 4 Hz.
 
-#include "arm_driver/grasp_machine.hpp"
+#include "grasp/grasp_machine.hpp"
 
 #include <gtest/gtest.h>
 
@@ -17,8 +17,15 @@
 
 #include "stereograsp/arm_cmd_t.hpp"
 
-namespace sg::arm {
+namespace sg::grasp {
 namespace {
+
+using arm::IkResult;
+using arm::pose_from_xyz_rpy;
+using arm::rpy_from_rotation;
+using arm::solve_nearest;
+using arm::forward_kinematics;
+using arm::motion_time;
 
 using Cmd = stereograsp::arm_cmd_t;
 
@@ -813,4 +820,4 @@ TEST(GraspMachineTest, Names) {
 }
 
 }  // namespace
-}  // namespace sg::arm
+}  // namespace sg::grasp

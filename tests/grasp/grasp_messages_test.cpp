@@ -1,14 +1,21 @@
 // The grasp machine's values as LCM messages: every field carried across, malformed trajectories
 // refused with the reason.
 
-#include "arm_driver/grasp_messages.hpp"
+#include "grasp/grasp_messages.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-namespace sg::arm {
+namespace sg::grasp {
 namespace {
+
+using arm::IkResult;
+using arm::pose_from_xyz_rpy;
+using arm::rpy_from_rotation;
+using arm::solve_nearest;
+using arm::forward_kinematics;
+using arm::motion_time;
 
 using stereograsp::arm_cmd_t;
 using stereograsp::arm_status_t;
@@ -131,4 +138,4 @@ TEST(GraspMessages, MalformedTrajectoriesAreRefused) {
 }
 
 }  // namespace
-}  // namespace sg::arm
+}  // namespace sg::grasp

@@ -1,4 +1,4 @@
-#include "arm_driver/interception.hpp"
+#include "grasp/interception.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,13 @@
 #include <string>
 #include <utility>
 
-namespace sg::arm {
+namespace sg::grasp {
+
+using arm::rpy_from_rotation;
+using arm::IkResult;
+using arm::solve_nearest;
+using arm::pose_from_xyz_rpy;
+using arm::motion_time;
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -178,4 +184,4 @@ Interception intercept(const ArmGeometry& arm, const PredictedPath& path, const 
   return fail(out, "did not converge in " + std::to_string(out.iterations) + " iterations");
 }
 
-}  // namespace sg::arm
+}  // namespace sg::grasp

@@ -1,4 +1,4 @@
-#include "arm_driver/grasp_machine.hpp"
+#include "grasp/grasp_machine.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +10,11 @@
 #include "common/grasp_names.hpp"
 #include "stereograsp/arm_cmd_t.hpp"
 
-namespace sg::arm {
+namespace sg::grasp {
+
+using arm::rpy_from_rotation;
+using arm::forward_kinematics;
+using arm::motion_time;
 namespace {
 
 using Cmd = stereograsp::arm_cmd_t;
@@ -520,4 +524,4 @@ void GraspMachine::set_message(std::string message) {
   message_is_refusal_ = false;
 }
 
-}  // namespace sg::arm
+}  // namespace sg::grasp

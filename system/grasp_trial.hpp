@@ -4,16 +4,16 @@
 /// system (issue 8): rendered stereo frames (CameraSimulator), the vision library behind
 /// sg-vision (BlobTracker per camera, triangulate() with the true calibration), the predictor
 /// behind sg-predictor (TrajectoryPredictor at 4 Hz), the grasp state machine behind sg-grasp
-/// (arm::GraspMachine) and the C550 controller model (C550Controller) behind a model of
+/// (grasp::GraspMachine) and the C550 controller model (C550Controller) behind a model of
 /// sg-arm-driver's timing (docs/arm.md): a request is validated (arm::CommandValidator), waits in
 /// a latest-wins slot while an interaction is in flight, and each motion command (MA, READY,
 /// OPEN, CLOSE) executes one interaction_delay() after it is sent; the machine sees ARM_STATUS
 /// at 20 Hz and when an interaction ends, with the joints read by W2.
 ///
-///     sg::sim::TrialParams params = sg::sim::paper_trial(/*seed=*/7);
+///     sg::system::TrialParams params = sg::system::paper_trial(/*seed=*/7);
 ///     params.sim.scenario.rpm = 1.5;
 ///     params.render = false;             // truth + Gaussian noise instead of images + vision
-///     sg::sim::TrialResult r = sg::sim::run_grasp_trial(params);
+///     sg::system::TrialResult r = sg::system::run_grasp_trial(params);
 ///     if (r.closed) std::printf("miss %.1f mm, held: %d\n", r.miss_distance * 1e3, r.success);
 ///
 /// Times inside a trial are seconds from its start; the machine, the predictor and the
@@ -26,13 +26,16 @@
 #include <string>
 #include <vector>
 
-#include "arm_driver/grasp_machine.hpp"
+#include "grasp/grasp_machine.hpp"
 #include "predictor/trajectory_predictor.hpp"
 #include "sim/c550_controller.hpp"
 #include "sim/camera_simulator.hpp"
 #include "vision/blob_tracker.hpp"
 
-namespace sg::sim {
+namespace sg::system {
+
+using sim::C550Params;
+using sim::SimParams;
 
 /// The fake epoch of a trial's clock, microseconds (2023-11-14).
 inline constexpr int64_t kTrialEpochUtime = 1'700'000'000'000'000;
@@ -48,7 +51,7 @@ struct TrialParams {
   predictor::PredictorParams predictor;
   arm::ArmGeometry arm = arm::ArmGeometry::a465();
   C550Params c550;
-  arm::GraspSettings grasp;    ///< use_prediction = false is the --no-prediction baseline
+  grasp::GraspSettings grasp;    ///< use_prediction = false is the --no-prediction baseline
   double status_rate = 20.0;   ///< Hz: ARM_STATUS between interactions
   double w2_time = 0.005;      ///< s: the W2 that ends an interaction (and an ABORT's answer)
   double bus_latency = 0.001;  ///< s: an ARM_STATUS sent on a change reaches the machine later
@@ -79,8 +82,8 @@ struct TrialResult {
   double timing_error = std::nan("");  ///< s: actual close - target_utime
   double track_age = std::nan("");     ///< s: close time - last visible measurement before it
   double end_time = 0;                 ///< s: when the trial stopped
-  arm::GraspOutcome outcome = arm::GraspOutcome::kNone;
-  arm::GraspState final_state = arm::GraspState::kHandOpened;
+  grasp::GraspOutcome outcome = grasp::GraspOutcome::kNone;
+  grasp::GraspState final_state = grasp::GraspState::kHandOpened;
   std::string message;               ///< the machine's last status message
   std::string arm_rejection;         ///< the last reason the driver model or controller refused
   int frames = 0;                    ///< stereo frames (or truth samples)
@@ -97,4 +100,4 @@ struct TrialResult {
 /// parameter out of range, a non-positive rate).
 TrialResult run_grasp_trial(const TrialParams& params);
 
-}  // namespace sg::sim
+}  // namespace sg::system

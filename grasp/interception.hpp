@@ -26,7 +26,10 @@
 
 #include "arm_driver/kinematics.hpp"
 
-namespace sg::arm {
+namespace sg::grasp {
+
+using arm::ArmGeometry;
+using arm::Joints;
 
 /// The ball's predicted path: points[i] at start_utime + i * period_us (trajectory_t).
 struct PredictedPath {
@@ -100,4 +103,4 @@ Interception intercept(const ArmGeometry& arm, const PredictedPath& path, const 
                        const Eigen::Vector3d& offset, double speed,
                        const InterceptionSettings& settings);
 
-}  // namespace sg::arm
+}  // namespace sg::grasp
