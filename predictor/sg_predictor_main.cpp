@@ -22,6 +22,7 @@
 #include "common/program.hpp"
 #include "common/shutdown.hpp"
 #include "predictor/burg.hpp"
+#include "predictor/trajectory_message.hpp"
 #include "predictor/trajectory_predictor.hpp"
 
 namespace {
@@ -30,25 +31,6 @@ using sg::predictor::Forecast;
 using sg::predictor::Measurement;
 using sg::predictor::PredictorParams;
 using sg::predictor::TrackStatus;
-
-stereograsp::trajectory_t to_message(const Forecast& f, const PredictorParams& p) {
-  stereograsp::trajectory_t t{};
-  t.utime = f.utime;
-  t.source_utime = f.source_utime;
-  t.start_utime = f.utime + f.period_us;
-  t.period_us = f.period_us;
-  t.num_points = static_cast<int32_t>(f.positions.size());
-  for (const auto& q : f.positions) t.position.push_back({q.x(), q.y(), q.z()});
-  t.occluded_samples = f.occluded_samples;
-  t.status = f.status == TrackStatus::kOccluded ? stereograsp::trajectory_t::STATUS_OCCLUDED
-             : f.status == TrackStatus::kLost   ? stereograsp::trajectory_t::STATUS_LOST
-                                                : stereograsp::trajectory_t::STATUS_TRACKING;
-  t.model = p.model == sg::predictor::Model::kBurg     ? stereograsp::trajectory_t::MODEL_BURG
-            : p.model == sg::predictor::Model::kKalman ? stereograsp::trajectory_t::MODEL_KALMAN
-                                                       : stereograsp::trajectory_t::MODEL_HOLD;
-  t.model_order = p.model == sg::predictor::Model::kBurg ? p.burg.order : 0;
-  return t;
-}
 
 PredictorParams load_params(const sg::Config& c) {
   PredictorParams p;
@@ -103,8 +85,7 @@ int run(const std::string& url, const PredictorParams& params) {
   bus.subscribe<stereograsp::point3_t>(
       "OBJECT_POSITION", [&](const stereograsp::point3_t& m, const auto&) {
         const uint64_t rejected = predictor.rejected();
-        const auto forecasts =
-            predictor.add({m.utime, m.visible != 0, {m.position[0], m.position[1], m.position[2]}});
+        const auto forecasts = predictor.add(sg::predictor::measurement_of(m));
         if (predictor.rejected() > rejected &&
             (predictor.rejected() <= 10 || predictor.rejected() % 1000 == 0)) {
           spdlog::warn(
@@ -113,7 +94,7 @@ int run(const std::string& url, const PredictorParams& params) {
               m.utime, predictor.rejected());
         }
         for (const Forecast& f : forecasts) {
-          bus.publish("OBJECT_TRAJECTORY", to_message(f, params));
+          bus.publish("OBJECT_TRAJECTORY", sg::predictor::to_trajectory_t(f, params));
           ++published;
         }
       });

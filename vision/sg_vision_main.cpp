@@ -27,7 +27,7 @@
 #include "vision/image_folder.hpp"
 #include "vision/image_message.hpp"
 #include "vision/stereo_pairer.hpp"
-#include "vision/triangulation.hpp"
+#include "vision/stereo_step.hpp"
 #include "vision/vision_config.hpp"
 
 namespace {
@@ -50,90 +50,45 @@ struct Options {
   double pair_tolerance_ms = 5.0;
 };
 
-/// Tracks both cameras of each stereo pair and publishes what it found.
+/// Runs the stereo step on each pair and publishes what it found.
 class StereoVision {
  public:
   StereoVision(sg::Bus& bus, const sg::vision::BlobTracker::Params& params, cv::Size size,
                std::optional<sg::vision::StereoCalibration> calibration, bool publish_images)
-      : bus_(bus),
-        trackers_{sg::vision::BlobTracker(params, size), sg::vision::BlobTracker(params, size)},
-        size_(size),
-        calibration_(std::move(calibration)),
-        publish_images_(publish_images) {}
+      : bus_(bus), step_(params, size, std::move(calibration)), publish_images_(publish_images) {}
 
   void process(const cv::Mat& left, const cv::Mat& right, int64_t frame_number, int64_t utime) {
-    const cv::Mat* images[2] = {&left, &right};
-    sg::vision::Observation o[2];
-    for (int i = 0; i < 2; ++i) {  // track both, then publish: the position first, so that a
-                                   // viewer drawing on the blobs has the frame's position too
-      if (images[i]->size() != size_) {
-        reset_size(images[i]->size());
-      }
-      if (publish_images_) {
+    if (publish_images_) {
+      const cv::Mat* images[2] = {&left, &right};
+      for (int i = 0; i < 2; ++i)
         bus_.publish(i == 0 ? "CAMERA_LEFT" : "CAMERA_RIGHT",
                      sg::vision::encode_image(*images[i], static_cast<int8_t>(i), frame_number,
                                               utime, true));
-      }
-      o[i] = trackers_[i].track(*images[i]);
-      found_[i] += o[i].found;
-      tracking_[i] += o[i].tracking;
     }
-    ++pairs_;
-    if (calibration_) publish_position(o, utime);
-    for (int i = 0; i < 2; ++i) {
-      bus_.publish(i == 0 ? "BLOB_LEFT" : "BLOB_RIGHT",
-                   sg::vision::to_blob_t(o[i], static_cast<int8_t>(i), frame_number, utime));
-    }
+    const sg::vision::StereoOutput out = step_.process(left, right, frame_number, utime);
+    // The position first, so that a viewer drawing on the blobs has the frame's position too.
+    if (out.position) bus_.publish("OBJECT_POSITION", *out.position);
+    bus_.publish("BLOB_LEFT", out.blob[0]);
+    bus_.publish("BLOB_RIGHT", out.blob[1]);
   }
 
   void report(uint64_t unmatched, uint64_t bad_images) const {
+    const sg::vision::StereoCounts& c = step_.counts();
     auto pct = [&](uint64_t n) {
-      return pairs_ ? 100.0 * static_cast<double>(n) / static_cast<double>(pairs_) : 0.0;
+      return c.pairs ? 100.0 * static_cast<double>(n) / static_cast<double>(c.pairs) : 0.0;
     };
     std::printf(
         "processed %llu stereo frames: ball found left %.1f%%, right %.1f%%; tracking mode "
         "left %.1f%%, right %.1f%%; %llu unmatched frames, %llu bad images\n",
-        static_cast<unsigned long long>(pairs_), pct(found_[0]), pct(found_[1]), pct(tracking_[0]),
-        pct(tracking_[1]), static_cast<unsigned long long>(unmatched),
+        static_cast<unsigned long long>(c.pairs), pct(c.found[0]), pct(c.found[1]),
+        pct(c.tracking[0]), pct(c.tracking[1]), static_cast<unsigned long long>(unmatched),
         static_cast<unsigned long long>(bad_images));
   }
 
  private:
-  void reset_size(cv::Size size) {
-    spdlog::warn("frame size changed to {}x{}: tracking restarts", size.width, size.height);
-    size_ = size;
-    trackers_ = {sg::vision::BlobTracker(trackers_[0].params(), size),
-                 sg::vision::BlobTracker(trackers_[1].params(), size)};
-  }
-
-  void publish_position(const sg::vision::Observation o[2], int64_t utime) {
-    point3_t p{};
-    p.utime = utime;
-    p.seen_by = static_cast<int8_t>((o[0].found ? point3_t::SEEN_LEFT : 0) |
-                                    (o[1].found ? point3_t::SEEN_RIGHT : 0));
-    p.visible = o[0].found && o[1].found;
-    const double nan = std::nan("");
-    for (int i = 0; i < 3; ++i) p.position[i] = p.position_sigma[i] = nan;
-    p.reprojection_error = nan;
-    if (p.visible) {  // eq. 26, refined on the reprojection error, with its uncertainty
-      const auto t = sg::vision::triangulate({&calibration_->left, &calibration_->right},
-                                             {{o[0].blob.centroid.x, o[0].blob.centroid.y},
-                                              {o[1].blob.centroid.x, o[1].blob.centroid.y}});
-      for (int i = 0; i < 3; ++i) p.position[i] = t.position[i], p.position_sigma[i] = t.sigma[i];
-      p.reprojection_error = t.reprojection_error;
-      if (t.behind_camera) p.flags |= point3_t::FLAG_BEHIND_CAMERA;
-      if (t.near_parallel) p.flags |= point3_t::FLAG_NEAR_PARALLEL_RAYS;
-      if (t.reprojection_error > 3.0) p.flags |= point3_t::FLAG_LARGE_RESIDUAL;
-    }
-    bus_.publish("OBJECT_POSITION", p);
-  }
-
   sg::Bus& bus_;
-  std::array<sg::vision::BlobTracker, 2> trackers_;
-  cv::Size size_;
-  std::optional<sg::vision::StereoCalibration> calibration_;
+  sg::vision::StereoStep step_;
   bool publish_images_;
-  uint64_t pairs_ = 0, found_[2] = {0, 0}, tracking_[2] = {0, 0};
 };
 
 int run_lcm(sg::Bus& bus, StereoVision& vision, const Options& o) {
