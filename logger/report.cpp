@@ -445,9 +445,13 @@ ReportResult make_report(const std::string& log_path, const ReportOptions& optio
 #endif
   if (options.plots) {
 #ifdef SG_HAVE_SESSION_PLOTS
-    for (const std::string& png : write_session_plots(stats.plot_data(), r.dir))
-      files.push_back(fs::path(png).filename().string());
-    r.plots_written = true;
+    try {  // no gnuplot, or gnuplot failing, skips the plots only: one note says why
+      for (const std::string& png : write_session_plots(stats.plot_data(), r.dir))
+        files.push_back(fs::path(png).filename().string());
+      r.plots_written = true;
+    } catch (const PlotError& e) {
+      r.notes.push_back(std::string("plots skipped: ") + e.what());
+    }
 #else
     // TODO(session_plots): logger/session_plots.hpp is not in this build; no plots drawn.
     r.notes.push_back("plots not drawn: this build has no logger/session_plots");

@@ -1,5 +1,7 @@
-// Plot (logger/plot.hpp) and the session figures (logger/session_plots.hpp): PNGs that decode,
-// pixels where the data says they should be, nice ticks, and no crash on empty or odd input.
+// The gnuplot layer (logger/plot.hpp) and the session figures (logger/session_plots.hpp): data
+// files and scripts for known input, PNGs read back (size, not blank, the series' colours where
+// expected), gnuplot's errors reported in one line, and a missing gnuplot skipping the plots
+// while the report is still written.
 
 #include "logger/plot.hpp"
 
@@ -8,19 +10,23 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <lcm/lcm-cpp.hpp>
 #include <limits>
 #include <opencv2/imgcodecs.hpp>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "common/message_types.hpp"
+#include "logger/report.hpp"
 #include "logger/session_plots.hpp"
 #include "tests/support/subprocess.hpp"
 
 namespace sg::logger {
 namespace {
 
+namespace fs = std::filesystem;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // A new temporary directory, removed with its contents at the end of the test (kept, to look at
 // the figures, when the environment sets SG_KEEP_TEST_FILES).
@@ -29,223 +35,126 @@ struct TempDir {
   ~TempDir() {
     if (std::getenv("SG_KEEP_TEST_FILES") != nullptr) return;
     std::error_code ignored;
-    std::filesystem::remove_all(path, ignored);
+    fs::remove_all(path, ignored);
   }
   std::string path;
 };
 
-// Sum of absolute channel differences between a pixel and a BGR colour.
-int distance(const cv::Vec3b& pixel, const cv::Scalar& colour) {
-  int d = 0;
-  for (int c = 0; c < 3; ++c) d += std::abs(pixel[c] - static_cast<int>(colour[c]));
-  return d;
+// Sum of absolute channel differences between a pixel (OpenCV's BGR) and a colour.
+int distance(const cv::Vec3b& pixel, const Rgb& rgb) {
+  return std::abs(pixel[2] - rgb.r) + std::abs(pixel[1] - rgb.g) + std::abs(pixel[0] - rgb.b);
 }
 
-// True when a pixel within `radius` of `at` is within `tolerance` of `colour`.
-bool colour_near(const cv::Mat& image, cv::Point2d at, const cv::Scalar& colour, int radius = 1,
-                 int tolerance = 60) {
-  const int cx = static_cast<int>(std::lround(at.x)), cy = static_cast<int>(std::lround(at.y));
-  for (int y = cy - radius; y <= cy + radius; ++y) {
-    for (int x = cx - radius; x <= cx + radius; ++x) {
-      if (x < 0 || y < 0 || x >= image.cols || y >= image.rows) continue;
-      if (distance(image.at<cv::Vec3b>(y, x), colour) <= tolerance) return true;
-    }
+// Pixels of `image` within `tolerance` of `rgb` (0: exactly it).
+int count_colour(const cv::Mat& image, const Rgb& rgb, int tolerance = 0) {
+  int n = 0;
+  for (int y = 0; y < image.rows; ++y) {
+    for (int x = 0; x < image.cols; ++x) n += distance(image.at<cv::Vec3b>(y, x), rgb) <= tolerance;
   }
-  return false;
+  return n;
 }
 
-// Pixels that are not the background.
 int count_non_background(const cv::Mat& image) {
-  int n = 0;
-  for (int y = 0; y < image.rows; ++y) {
-    for (int x = 0; x < image.cols; ++x) {
-      n += distance(image.at<cv::Vec3b>(y, x), palette::kBackground) != 0;
+  return image.rows * image.cols - count_colour(image, palette::kBackground);
+}
+
+// Rows of a single-column-pair series.
+std::vector<std::vector<double>> pairs(const std::vector<std::pair<double, double>>& points) {
+  std::vector<std::vector<double>> rows;
+  for (const auto& [a, b] : points) rows.push_back({a, b});
+  return rows;
+}
+
+// Blocks are separated by two blank lines, a non-finite row becomes one blank line (a break),
+// an all-non-finite block is not written.
+TEST(GnuplotData, BlocksBreaksAndEmptyBlocks) {
+  GnuplotData data;
+  EXPECT_EQ(data.add_block("first", pairs({{0, 1}, {kNaN, 0}, {kInf, 1}, {2, 3.5}, {4, kNaN}})), 0);
+  EXPECT_EQ(data.add_block("nothing finite", pairs({{kNaN, 1}, {2, kInf}})), -1);
+  EXPECT_EQ(data.add_block("none", {}), -1);
+  EXPECT_EQ(data.add_block("second\nline", pairs({{-0.25, 1e-7}, {1234567.125, 1.0 / 3}})), 1);
+  EXPECT_EQ(data.text(),
+            "# first\n0 1\n\n2 3.5\n\n\n\n"
+            "# second?line\n-0.25 1e-07\n1234567.125 0.3333333333\n");
+  EXPECT_EQ(data.blocks(), 2);
+  EXPECT_EQ(data.rows(0), 2);
+  EXPECT_EQ(data.rows(1), 2);
+  EXPECT_EQ(data.rows(-1), 0);
+}
+
+// Text can only ever be a string in a script: quotes doubled, control bytes and non-ASCII
+// replaced, long text shortened.
+TEST(GnuplotText, StringsAndNumbers) {
+  EXPECT_EQ(gnuplot_string("q4 object lifted (success)"), "'q4 object lifted (success)'");
+  EXPECT_EQ(gnuplot_string("it's"), "'it''s'");
+  EXPECT_EQ(gnuplot_string("a\nb\x01\xc2\xb5"), std::string("'a?b") + std::string(3, '?') + "'");
+  EXPECT_EQ(gnuplot_string("abcdefghij", 8), "'abcde...'");
+  EXPECT_EQ(gnuplot_number(0.1), "0.1");
+  EXPECT_EQ(gnuplot_number(-1.0 / 3), "-0.3333333333");
+  EXPECT_EQ(gnuplot_number(kNaN), "NaN");
+  EXPECT_EQ(gnuplot_number(-kInf), "-1e308");
+  EXPECT_EQ((Rgb{31, 119, 180}.hex()), "#1f77b4");
+}
+
+// A gnuplot that is not there is one line naming the Debian package.
+TEST(Gnuplot, MissingProgramIsOneLine) {
+  for (const std::string& program :
+       {std::string("/nonexistent/gnuplot"), std::string("sg-no-such-gnuplot")}) {
+    try {
+      find_gnuplot(program);
+      FAIL() << program;
+    } catch (const GnuplotMissing& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(program), std::string::npos) << what;
+      EXPECT_NE(what.find("gnuplot-nox"), std::string::npos) << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
     }
   }
-  return n;
+  EXPECT_EQ(fs::path(find_gnuplot()).filename(), "gnuplot");  // installed by bootstrap.sh
 }
 
-// Pixels exactly of `colour`.
-int count_colour(const cv::Mat& image, const cv::Scalar& colour) {
-  int n = 0;
-  for (int y = 0; y < image.rows; ++y) {
-    for (int x = 0; x < image.cols; ++x) n += distance(image.at<cv::Vec3b>(y, x), colour) == 0;
-  }
-  return n;
-}
-
-void expect_ticks(const std::vector<double>& actual, const std::vector<double>& expected) {
-  ASSERT_EQ(actual.size(), expected.size());
-  for (size_t i = 0; i < expected.size(); ++i) EXPECT_NEAR(actual[i], expected[i], 1e-12) << i;
-}
-
-// Ticks step by 1, 2 or 5 times a power of ten and cover the range.
-TEST(Plot, NiceTicksForKnownRanges) {
-  expect_ticks(Plot::nice_ticks(0, 1), {0, 0.2, 0.4, 0.6, 0.8, 1.0});
-  expect_ticks(Plot::nice_ticks(0, 7), {0, 2, 4, 6, 8});
-  expect_ticks(Plot::nice_ticks(-3, 3), {-3, -2, -1, 0, 1, 2, 3});
-  expect_ticks(Plot::nice_ticks(-3, 3, 5), {-4, -2, 0, 2, 4});
-  expect_ticks(Plot::nice_ticks(0.12, 0.47), {0.1, 0.2, 0.3, 0.4, 0.5});
-  expect_ticks(Plot::nice_ticks(0, 1000, 5), {0, 500, 1000});
-  expect_ticks(Plot::nice_ticks(-0.003, 0.0011), {-0.003, -0.002, -0.001, 0, 0.001, 0.002});
-  // Exact doubles: 3 * 0.2 is the double nearest 0.6, not 0.6000000000000001.
-  EXPECT_EQ(Plot::nice_ticks(0, 1)[3], 0.6);
-}
-
-// A zero, reversed or non-finite range still gives at least two finite ticks around the value.
-TEST(Plot, NiceTicksForDegenerateRanges) {
-  for (auto [lo, hi] : std::vector<std::pair<double, double>>{
-           {5, 5}, {0, 0}, {-2e-9, -2e-9}, {3, 1}, {kNaN, 1}, {0, kNaN}, {1e300, 1e300}}) {
-    const std::vector<double> ticks = Plot::nice_ticks(lo, hi);
-    ASSERT_GE(ticks.size(), 2u) << lo << " " << hi;
-    ASSERT_LE(ticks.size(), 7u) << lo << " " << hi;
-    for (double t : ticks) EXPECT_TRUE(std::isfinite(t)) << lo << " " << hi;
-    EXPECT_LT(ticks.front(), ticks.back());
-    if (std::isfinite(lo) && std::isfinite(hi)) {
-      EXPECT_LE(ticks.front(), std::min(lo, hi));
-      EXPECT_GE(ticks.back(), std::max(lo, hi));
-    }
-  }
-}
-
-// A known line's PNG decodes at the requested size, with the line's colour at computed pixels.
-TEST(Plot, LineDrawnAtComputedPixels) {
+// gnuplot draws a known script at the requested size; a label made by gnuplot_string from
+// hostile text stays a label (no command runs); a broken script gives gnuplot's message.
+TEST(Gnuplot, RunsScriptsAndReportsErrors) {
   const TempDir temp;
-  const std::string& dir = temp.path;
-  Plot plot(420, 310, "y = 2x", "x", "y");
-  std::vector<double> xs, ys;
-  for (int i = 0; i <= 10; ++i) {
-    xs.push_back(i);
-    ys.push_back(2.0 * i);
-  }
-  plot.line(xs, ys, palette::kRed);
-  const std::string path = dir + "/line.png";
-  ASSERT_TRUE(plot.save(path));
-  const cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);
+  const std::string gnuplot = find_gnuplot();
+  write_text_file(temp.path + "/t.gp",
+                  "set terminal pngcairo size 320,240\nset output 't.png'\n"
+                  "set label " +
+                      gnuplot_string("x'; system('touch pwned'); '") +
+                      " at graph 0.1, graph 0.5\n"
+                      "set xrange [0:1]\nset yrange [0:1]\n"
+                      "set object rect from 0.2, 0.2 to 0.8, 0.8 fc rgb '#ffe4b5' fs solid 1.0 "
+                      "noborder\nplot NaN notitle\n");
+  run_gnuplot(gnuplot, temp.path, "t.gp");
+  const cv::Mat image = cv::imread(temp.path + "/t.png");
   ASSERT_FALSE(image.empty());
-  EXPECT_EQ(image.cols, 420);
-  EXPECT_EQ(image.rows, 310);
+  EXPECT_EQ(image.cols, 320);
+  EXPECT_EQ(image.rows, 240);
+  EXPECT_GT(count_colour(image, palette::kShade), 5000);
+  EXPECT_FALSE(fs::exists(temp.path + "/pwned"));
 
-  // Ticks 0, 2, ..., 10 for x and 0, 5, ..., 20 (or similar) for y: the range is the data's.
-  EXPECT_DOUBLE_EQ(plot.x_ticks().front(), 0);
-  EXPECT_DOUBLE_EQ(plot.x_ticks().back(), 10);
-  EXPECT_DOUBLE_EQ(plot.y_ticks().front(), 0);
-  EXPECT_DOUBLE_EQ(plot.y_ticks().back(), 20);
-  const cv::Rect area = plot.plot_area();
-  EXPECT_NEAR(plot.pixel(0, 0).x, area.x, 1e-9);
-  EXPECT_NEAR(plot.pixel(0, 0).y, area.y + area.height, 1e-9);
-  EXPECT_NEAR(plot.pixel(10, 20).x, area.x + area.width, 1e-9);
-  EXPECT_NEAR(plot.pixel(10, 20).y, area.y, 1e-9);
-
-  int on_line = 0, samples = 0;
-  for (double x = 0.25; x <= 9.75; x += 0.25, ++samples) {
-    on_line += colour_near(image, plot.pixel(x, 2 * x), palette::kRed);
-  }
-  EXPECT_EQ(on_line, samples);
-  EXPECT_FALSE(colour_near(image, plot.pixel(8, 4), palette::kRed, 3));
-  EXPECT_FALSE(colour_near(image, plot.pixel(2, 16), palette::kRed, 3));
-  EXPECT_EQ(distance(image.at<cv::Vec3b>(cv::Point(plot.pixel(8, 4))), palette::kBackground), 0);
-}
-
-// Markers, a shaded band, bars and a legend each put their colour where expected.
-TEST(Plot, MarkersBandsBarsAndLegend) {
-  Plot plot(600, 400, "markers", "x", "y");
-  plot.shade_x(2, 3, palette::kShade, "band");
-  plot.bars({0, 1, 2}, {1, 3}, palette::kGreen, "bars");
-  plot.crosses({5}, {2}, palette::kBlue, "crosses", 6);
-  plot.circles({7}, {1}, palette::kOrange, "circles", 6);
-  plot.vline(9, palette::kPurple, "event");
-  const cv::Mat image = plot.render();
-  ASSERT_EQ(image.cols, 600);
-  ASSERT_EQ(image.rows, 400);
-  // Band: flat colour across its width at mid-height.
-  EXPECT_EQ(distance(image.at<cv::Vec3b>(cv::Point(plot.pixel(2.5, 1.5))), palette::kShade), 0);
-  EXPECT_GT(count_colour(image, palette::kShade), 100);
-  // Bars: filled at their centre, below their count; not above it.
-  EXPECT_EQ(distance(image.at<cv::Vec3b>(cv::Point(plot.pixel(1.5, 1.5))), palette::kGreen), 0);
-  EXPECT_FALSE(colour_near(image, plot.pixel(0.5, 2.0), palette::kGreen, 2, 0));
-  // A cross has its arms' ends 6 pixels off diagonally; a circle has its rim 6 pixels away.
-  const cv::Point2d cross = plot.pixel(5, 2), circle = plot.pixel(7, 1);
-  EXPECT_TRUE(colour_near(image, cross + cv::Point2d(5, 5), palette::kBlue));
-  EXPECT_TRUE(colour_near(image, cross + cv::Point2d(-5, 5), palette::kBlue));
-  EXPECT_TRUE(colour_near(image, circle + cv::Point2d(6, 0), palette::kOrange));
-  EXPECT_TRUE(colour_near(image, circle + cv::Point2d(0, -6), palette::kOrange));
-  EXPECT_FALSE(colour_near(image, circle, palette::kOrange, 2));  // open circles
-  // The dashed marker.
-  int dashes = 0;
-  for (double y = 0.2; y < 3; y += 0.1)
-    dashes += colour_near(image, plot.pixel(9, y), palette::kPurple, 0);
-  EXPECT_GT(dashes, 10);
-  EXPECT_LT(dashes, 28);
-}
-
-// Equal aspect makes one unit as long in x as in y; a log x axis spaces decades evenly.
-TEST(Plot, EqualAspectAndLogScale) {
-  Plot plane(500, 300, "plane", "X (m)", "Y (m)");
-  plane.set_equal_aspect(true);
-  plane.line({0, 1}, {0, 0.1}, palette::kBlue);
-  const cv::Point2d o = plane.pixel(0, 0), x1 = plane.pixel(1, 0), y1 = plane.pixel(0, 1);
-  EXPECT_NEAR(x1.x - o.x, o.y - y1.y, 1e-6);
-  const cv::Rect area = plane.plot_area();
-  EXPECT_GE(plane.pixel(0, 0.1).y, area.y);  // all data inside
-  EXPECT_LE(plane.pixel(1, 0).x, area.x + area.width + 1e-9);
-
-  Plot log(500, 300, "log", "ms", "count");
-  log.set_log_x(true);
-  log.bars({0.1, 1, 10, 100, 1000}, {1, 5, 2, 0}, palette::kBlue);
-  EXPECT_NEAR(log.pixel(10, 0).x - log.pixel(1, 0).x, log.pixel(100, 0).x - log.pixel(10, 0).x,
-              1e-6);
-  const std::vector<double> ticks = log.x_ticks();
-  ASSERT_EQ(ticks.size(), 5u);
-  EXPECT_NEAR(ticks.front(), 0.1, 1e-12);
-  EXPECT_NEAR(ticks.back(), 1000, 1e-9);
-  EXPECT_GT(count_non_background(log.render()), 1000);
-}
-
-// Empty, single-point, constant, all-NaN and non-positive-on-log series render and save.
-TEST(Plot, DegenerateSeriesStillSave) {
-  const TempDir temp;
-  const std::string& dir = temp.path;
-  std::vector<Plot> plots;
-  plots.emplace_back(300, 200, "empty", "x", "y");
-  plots.back().line({}, {}, palette::kBlue, "nothing");
-  plots.emplace_back(300, 200, "one point", "x", "y");
-  plots.back().line({3}, {3}, palette::kBlue, "one");
-  plots.back().crosses({3}, {3}, palette::kRed);
-  plots.emplace_back(300, 200, "constant", "x", "y");
-  plots.back().line({0, 1, 2}, {5, 5, 5}, palette::kBlue);
-  plots.emplace_back(300, 200, "nan", "x", "y");
-  plots.back().line({kNaN, 1, kNaN}, {kNaN, kNaN, 2}, palette::kBlue);
-  plots.back().shade_x(kNaN, 1, palette::kShade);
-  plots.emplace_back(300, 200, "log", "x", "y");
-  plots.back().set_log_x(true);
-  plots.back().line({-1, 0}, {1, 2}, palette::kBlue);
-  plots.emplace_back(10, 10, "", "", "");  // raised to the minimum size
-  plots.back().note("no data");
-  for (size_t i = 0; i < plots.size(); ++i) {
-    const std::string path = dir + "/plot" + std::to_string(i) + ".png";
-    ASSERT_TRUE(plots[i].save(path)) << i;
-    const cv::Mat image = cv::imread(path);
-    ASSERT_FALSE(image.empty()) << i;
-    EXPECT_GT(count_non_background(image), 100) << i;  // frame, ticks, text
-    for (double t : plots[i].x_ticks()) EXPECT_TRUE(std::isfinite(t)) << i;
-    for (double t : plots[i].y_ticks()) EXPECT_TRUE(std::isfinite(t)) << i;
-  }
-  EXPECT_EQ(cv::imread(dir + "/plot5.png").cols, 160);
-  // The single point: its cross is drawn at its pixel.
-  EXPECT_TRUE(colour_near(plots[1].render(), plots[1].pixel(3, 3), palette::kRed));
-}
-
-// A PNG that cannot be written throws an error that names the path.
-TEST(Plot, SaveFailureNamesThePath) {
-  Plot plot(200, 150, "t", "x", "y");
-  const std::string path = "/nonexistent-directory/sub/plot.png";
+  write_text_file(temp.path + "/bad.gp", "set terminal pngcairo\nplot no_such_variable\n");
   try {
-    plot.save(path);
+    run_gnuplot(gnuplot, temp.path, "bad.gp");
     FAIL() << "no exception";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  } catch (const PlotError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(temp.path + "/bad.gp"), std::string::npos) << what;
+    EXPECT_NE(what.find("line 2"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
   }
+}
+
+// Names of close markers go to the next free row; one that would pass the right edge ends at
+// its marker; with every row taken a marker gets no name.
+TEST(SessionPlots, LabelRows) {
+  // Axes 0..100 over 1000 px, 7 px a character: a 9-character name is 70 px (7 units) wide.
+  const std::vector<size_t> nine(6, 9);
+  EXPECT_EQ(label_rows({0, 10, 12, 14, 16, 30}, nine, 0, 100, 1000),
+            (std::vector<int>{0, 0, 1, 2, -1, 0}));
+  EXPECT_EQ(label_rows({95, 98}, {9, 9}, 0, 100, 1000), (std::vector<int>{0, 1}));
+  EXPECT_EQ(label_rows({1, 2}, {3, 3}, 5, 5, 1000), (std::vector<int>{-1, -1}));
 }
 
 // The bin edges of a Histogram: log-spaced when lo > 0 and hi / lo > 100, else linear.
@@ -286,50 +195,143 @@ PlotData synthetic_session() {
   return data;
 }
 
-// A synthetic session gives four PNGs full of drawing, with the occlusion band on y_time.png.
+// The colours a figure must show, each in at least `min` pixels (antialiased: near the colour).
+void expect_colours(const cv::Mat& image, const std::vector<Rgb>& colours, int min,
+                    const std::string& name) {
+  for (const Rgb& c : colours) EXPECT_GE(count_colour(image, c, 30), min) << name << c.hex();
+}
+
+// A synthetic session gives four PNGs of the set sizes showing every series' colour, the
+// occlusion band on y_time.png only, and data files and scripts with the known contents.
 TEST(SessionPlots, WritesFourFigures) {
   const TempDir temp;
   const std::string dir = temp.path + "/figures";
   const std::vector<std::string> paths = write_session_plots(synthetic_session(), dir);
   ASSERT_EQ(paths.size(), 4u);
-  const char* names[] = {"xy.png", "y_time.png", "latency.png", "arm.png"};
+  const char* names[] = {"xy", "y_time", "latency", "arm"};
+  const int sizes[][2] = {{800, 800}, {1100, 500}, {900, 3 * 230}, {1100, 820}};
+  std::vector<cv::Mat> images;
   for (size_t i = 0; i < 4; ++i) {
-    EXPECT_EQ(std::filesystem::path(paths[i]).filename(), names[i]);
-    const cv::Mat image = cv::imread(paths[i]);
-    ASSERT_FALSE(image.empty()) << paths[i];
-    EXPECT_GT(count_non_background(image), 8000) << paths[i];
+    EXPECT_EQ(paths[i], dir + "/" + names[i] + ".png");
+    EXPECT_TRUE(fs::exists(dir + "/" + names[i] + ".gp")) << names[i];
+    EXPECT_TRUE(fs::exists(dir + "/" + names[i] + ".dat")) << names[i];
+    images.push_back(cv::imread(paths[i]));
+    ASSERT_FALSE(images[i].empty()) << paths[i];
+    EXPECT_EQ(images[i].cols, sizes[i][0]) << names[i];
+    EXPECT_EQ(images[i].rows, sizes[i][1]) << names[i];
+    EXPECT_GT(count_non_background(images[i]), 8000) << names[i];
   }
-  const cv::Mat xy = cv::imread(paths[0]);
-  EXPECT_EQ(xy.cols, xy.rows);  // a square figure for the equal-aspect plane
-  EXPECT_GT(count_colour(cv::imread(paths[1]), palette::kShade), 5000);
-  EXPECT_EQ(count_colour(xy, palette::kShade), 0);
-  EXPECT_GT(cv::imread(paths[2]).rows, 3 * 200);  // a panel per stage
-  EXPECT_GT(cv::imread(paths[3]).rows, 3 * 200);  // x, y and z panels
+  expect_colours(images[0], {palette::kGreen, palette::kBlue, palette::kOrange}, 200, "xy");
+  expect_colours(images[1], {palette::kGreen, palette::kBlue, palette::kOrange, palette::kPurple},
+                 100, "y_time");
+  expect_colours(images[2], {palette::kBlue}, 2000, "latency");
+  expect_colours(images[3], {palette::kBlue, palette::kOrange, palette::kPurple}, 100, "arm");
+  EXPECT_GT(count_colour(images[1], palette::kShade), 20000);  // 2 s of 21.5, 370 px high
+  EXPECT_EQ(count_colour(images[0], palette::kShade), 0);
+  EXPECT_EQ(count_colour(images[1], palette::kNote, 30), 0);   // data: no "no data" note
+  EXPECT_GT(count_colour(images[2], palette::kNote, 30), 50);  // but the "arm" stage has none
+
+  // The numbers: truth at t = 0 is (0.65, 0), at 0.05 s (0.5 + 0.15 cos 0.03, 0.15 sin 0.03);
+  // 400 truth rows, 160 + 199 measured (t < 8 s or t > 10 s), 400 predicted; no gaps.
+  const std::string xy = test::read_text(dir + "/xy.dat");
+  EXPECT_EQ(
+      xy.rfind("# true (GROUND_TRUTH): X (m), Y (m)\n0.65 0\n0.6499325051 0.00449932503\n", 0), 0u)
+      << xy.substr(0, 200);
+  EXPECT_EQ(test::count_lines(xy), 3 + 400 + 359 + 400 + 2 * 2);
+  const std::string y_time = test::read_text(dir + "/y_time.gp");
+  for (const char* line :
+       {"set output 'y_time.png'", "set xlabel 'time (s)'", "set ylabel 'Y (m)'",
+        "set object rect from 8, graph 0 to 10, graph 1 behind fc rgb '#ffe4b5'",
+        "set label 'q1 approaching' at 5, graph 1 left", "title 'predicted (h = 4)'",
+        "'y_time.dat' index 2 using 1:2 with points pt 2"}) {
+    EXPECT_NE(y_time.find(line), std::string::npos) << line << "\n" << y_time;
+  }
+  const std::string latency = test::read_text(dir + "/latency.gp");
+  EXPECT_NE(latency.find("set title 'predictor: n = 51, median ~ 25 ms'"), std::string::npos);
+  EXPECT_NE(latency.find("set title 'vision: n = 275, median ~"), std::string::npos);
+  EXPECT_NE(test::read_text(dir + "/latency.dat").find("# predictor: bin from (ms)"),
+            std::string::npos);
 }
 
-// An empty PlotData still writes all four figures, each with a "no data" note.
+// A script re-run by hand in its directory draws the same figure again.
+TEST(SessionPlots, ScriptsRerunByHand) {
+  const TempDir temp;
+  write_session_plots(synthetic_session(), temp.path);
+  const std::string first = test::read_text(temp.path + "/arm.png");
+  fs::remove(temp.path + "/arm.png");
+  run_gnuplot(find_gnuplot(), temp.path, "arm.gp");
+  EXPECT_EQ(test::read_text(temp.path + "/arm.png"), first);
+}
+
+// An empty PlotData still writes all four figures, each with a "no data" note at its centre.
 TEST(SessionPlots, EmptyDataWritesNoDataFigures) {
   const TempDir temp;
-  const std::string& dir = temp.path;
   const PlotData empty;  // (not PlotData{}: DecimatedSeries' constructor is explicit)
-  const std::vector<std::string> paths = write_session_plots(empty, dir);
+  const std::vector<std::string> paths = write_session_plots(empty, temp.path);
   ASSERT_EQ(paths.size(), 4u);
-  // The note, in its own grey, sits at the centre of the axes (of the middle panel for arm.png).
   for (const std::string& path : paths) {
     const cv::Mat image = cv::imread(path);
     ASSERT_FALSE(image.empty()) << path;
     EXPECT_GT(count_non_background(image), 500) << path;
     const cv::Rect centre(image.cols / 2 - 100, image.rows / 2 - 40, 200, 80);
-    EXPECT_GT(count_colour(image(centre), palette::kNote), 50) << path;
+    EXPECT_GT(count_colour(image(centre), palette::kNote, 30), 50) << path;
   }
-  // With data there is no note (but latency.png's "arm" stage has no counts, so it has one).
-  const std::vector<std::string> full =
-      write_session_plots(synthetic_session(), temp.path + "/full");
-  ASSERT_EQ(full.size(), 4u);
-  EXPECT_EQ(count_colour(cv::imread(full[0]), palette::kNote), 0);
-  EXPECT_EQ(count_colour(cv::imread(full[1]), palette::kNote), 0);
-  EXPECT_GT(count_colour(cv::imread(full[2]), palette::kNote), 50);
-  EXPECT_EQ(count_colour(cv::imread(full[3]), palette::kNote), 0);
+}
+
+// Without gnuplot the data files and scripts are still written, and the error says so.
+TEST(SessionPlots, MissingGnuplotWritesScriptsAndThrows) {
+  const TempDir temp;
+  try {
+    write_session_plots(synthetic_session(), temp.path, "/nonexistent/gnuplot");
+    FAIL() << "no exception";
+  } catch (const GnuplotMissing& e) {
+    EXPECT_NE(std::string(e.what()).find("gnuplot-nox"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(temp.path + "/*.gp"), std::string::npos) << e.what();
+  }
+  for (const char* name : {"xy", "y_time", "latency", "arm"}) {
+    EXPECT_TRUE(fs::exists(temp.path + "/" + name + ".gp")) << name;
+    EXPECT_TRUE(fs::exists(temp.path + "/" + name + ".dat")) << name;
+    EXPECT_FALSE(fs::exists(temp.path + "/" + name + ".png")) << name;
+  }
+}
+
+// A report made where PATH holds no gnuplot: report.md, report.json and the CSV are written,
+// and one note says the plots were skipped and why.
+TEST(SessionPlots, ReportWithoutGnuplotSkipsPlotsOnly) {
+  const TempDir temp;
+  const std::string log_path = temp.path + "/session.lcmlog";
+  {
+    lcm::LogFile log(log_path, "w");
+    for (int k = 0; k < 30; ++k) {
+      stereograsp::point3_t p{};
+      p.utime = 1'700'000'000'000'000 + k * 33'333;
+      p.visible = true;
+      p.position[0] = 0.5;
+      std::vector<uint8_t> bytes = encode_message(p);
+      lcm::LogEvent e{0, p.utime + 5000, "OBJECT_POSITION", static_cast<int32_t>(bytes.size()),
+                      bytes.data()};
+      log.writeEvent(&e);
+    }
+  }
+  const std::string saved_path = std::getenv("PATH") ? std::getenv("PATH") : "";
+  setenv("PATH", (temp.path + "/no-programs-here").c_str(), 1);
+  ReportOptions options;
+  options.out_dir = temp.path + "/report";
+  ReportResult r;
+  EXPECT_NO_THROW(r = make_report(log_path, options));
+  setenv("PATH", saved_path.c_str(), 1);
+  EXPECT_FALSE(r.plots_written);
+  ASSERT_EQ(r.notes.size(), 1u);
+  EXPECT_EQ(r.notes[0].rfind("plots skipped: gnuplot not found on PATH (Debian package "
+                             "gnuplot-nox)",
+                             0),
+            0u)
+      << r.notes[0];
+  EXPECT_TRUE(fs::exists(options.out_dir + "/report.md"));
+  EXPECT_TRUE(fs::exists(options.out_dir + "/report.json"));
+  EXPECT_TRUE(fs::exists(options.out_dir + "/csv/OBJECT_POSITION.csv"));
+  EXPECT_TRUE(fs::exists(options.out_dir + "/xy.gp"));
+  EXPECT_FALSE(fs::exists(options.out_dir + "/xy.png"));
 }
 
 }  // namespace
