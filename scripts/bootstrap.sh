@@ -33,6 +33,7 @@ packages=(
   libopencv-dev                                    # images, video files, calibration
   libgtest-dev libgmock-dev libbenchmark-dev       # tests and benchmarks
   nlohmann-json3-dev                               # sg-report's report.json (and its tests)
+  gnuplot-nox                                      # sg-report's PNG figures (pngcairo terminal)
   iproute2 util-linux                              # ip and unshare for scripts/multicast.sh
 )
 
