@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -10,26 +11,21 @@ namespace {
 
 using Cmd = stereograsp::arm_cmd_t;
 using Status = stereograsp::arm_status_t;
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
 /// Wraps the line and adds up the time spent inside it (waiting for bytes, writing them): the
 /// rest of an interaction is the driver's own overhead.
 class TimedStream final : public ByteStream {
  public:
-  explicit TimedStream(std::unique_ptr<ByteStream> inner) : inner_(std::move(inner)) {}
+  TimedStream(std::unique_ptr<ByteStream> inner, Clock& clock)
+      : inner_(std::move(inner)), clock_(clock) {}
   void write(std::span<const uint8_t> bytes) override {
-    const auto start = Clock::now();
+    const double start = clock_.now();
     inner_->write(bytes);
-    inside_ += seconds_since(start);
+    inside_ += clock_.now() - start;
   }
   std::optional<uint8_t> read_byte(std::chrono::microseconds timeout) override {
-    const auto start = Clock::now();
+    const double start = clock_.now();
     auto byte = inner_->read_byte(timeout);
-    inside_ += seconds_since(start);
+    inside_ += clock_.now() - start;
     return byte;
   }
   void discard_input() override { inner_->discard_input(); }
@@ -37,6 +33,7 @@ class TimedStream final : public ByteStream {
 
  private:
   std::unique_ptr<ByteStream> inner_;
+  Clock& clock_;
   double inside_ = 0;
 };
 
@@ -60,8 +57,12 @@ void set_joints(const ArmGeometry& geometry, const Joints& q, Status& status) {
   }
 }
 
-ArmDriver::ArmDriver(ArmGeometry geometry, DriverSettings settings, DeviceOpener open_device)
-    : validator_(std::move(geometry)), settings_(settings), open_device_(std::move(open_device)) {
+ArmDriver::ArmDriver(ArmGeometry geometry, DriverSettings settings, DeviceOpener open_device,
+                     Clock& clock)
+    : validator_(std::move(geometry)),
+      settings_(settings),
+      open_device_(std::move(open_device)),
+      clock_(clock) {
   status_.state = Status::STATE_DISCONNECTED;
   status_.gripper = Status::GRIPPER_UNKNOWN;
   status_.last_received_sequence = -1;
@@ -94,7 +95,7 @@ void ArmDriver::submit(const Cmd& command) {
                  result.reason);
   }
   ++version_;
-  wake_.notify_all();
+  clock_.notify();
 }
 
 std::pair<Status, uint64_t> ArmDriver::status() const {
@@ -111,8 +112,8 @@ bool ArmDriver::connect(std::stop_token stop) {
   double wait = settings_.reconnect_min;
   while (!stop.stop_requested()) {
     try {
-      stream_ = std::make_unique<TimedStream>(open_device_());
-      link_ = std::make_unique<C550Link>(*stream_, settings_.slave, settings_.timing);
+      stream_ = std::make_unique<TimedStream>(open_device_(), clock_);
+      link_ = std::make_unique<C550Link>(*stream_, settings_.slave, settings_.timing, clock_);
       link_->open_session();
       speed_percent_ = -1;
       read_joints();
@@ -131,7 +132,7 @@ bool ArmDriver::connect(std::stop_token stop) {
       });
       spdlog::warn("cannot connect ({}); again in {:.1f} s", e.what(), wait);
       std::unique_lock lock(mutex_);
-      wake_.wait_for(lock, stop, std::chrono::duration<double>(wait), [] { return false; });
+      clock_.wait_until(lock, clock_.now() + wait, [] { return false; }, stop);
       wait = std::min(wait * 2, settings_.reconnect_max);
     }
   }
@@ -176,8 +177,50 @@ void ArmDriver::act(const ArmTarget& target) {
   }
 }
 
+void ArmDriver::send_speed(const ArmTarget& target) {
+  const double speed = std::min(target.speed, settings_.max_speed);
+  const int percent = std::clamp(static_cast<int>(std::lround(speed * 100)), 1, 100);
+  if (target.mode != Cmd::MODE_STOP && percent != speed_percent_) {
+    link_->command(rapl::speed(percent), settings_.timing.reply_timeout);
+    speed_percent_ = percent;
+  }
+}
+
+void ArmDriver::requeue_rest(ArmTarget target) {
+  // A motion delivered and a gripper action not: only the gripper action is tried again.
+  if (motion_done_ && target.gripper != Cmd::GRIPPER_KEEP) {
+    if (target.moves_arm()) update([&](Status&) { commanded_ = target.joints; });
+    target.mode = Cmd::MODE_GRIPPER_ONLY;
+  }
+  requeue(std::move(target));
+}
+
+void ArmDriver::record_executed(const ArmTarget& target) {
+  attempts_ = 0;
+  update([&](Status& s) {
+    s.last_executed_sequence = target.sequence;
+    s.speed = speed_percent_ / 100.0;
+    if (target.mode == Cmd::MODE_STOP || target.mode == Cmd::MODE_HOME) commanded_.reset();
+    if (target.moves_arm()) commanded_ = target.joints;
+    if (target.gripper == Cmd::GRIPPER_OPEN) s.gripper = Status::GRIPPER_OPEN;
+    if (target.gripper == Cmd::GRIPPER_CLOSE) s.gripper = Status::GRIPPER_CLOSED;
+    if (s.state == Status::STATE_ERROR) s.state = Status::STATE_MOVING;
+    s.error.clear();
+  });
+}
+
+void ArmDriver::record_refusal(const ArmTarget& target, const std::string& why) {
+  update([&](Status& s) {
+    s.last_executed_sequence = target.sequence;  // delivered: it ran, and the controller refused
+    s.last_rejected_sequence = target.sequence;
+    s.rejection_reason = "controller: " + why;
+    s.error = s.rejection_reason;
+    s.state = Status::STATE_ERROR;
+  });
+}
+
 void ArmDriver::execute(ArmTarget target) {
-  const auto start = Clock::now();
+  const double start = clock_.now();
   const double inside_before = static_cast<TimedStream&>(*stream_).inside();
   update([&](Status& s) {
     s.state = Status::STATE_MOVING;
@@ -187,64 +230,33 @@ void ArmDriver::execute(ArmTarget target) {
   // through, link_->delivered() tells about the SPEED, not the action.
   bool speed_done = false;
   motion_done_ = false;
-  // A motion delivered and a gripper action not: only the gripper action is tried again.
-  const auto requeue_rest = [&] {
-    if (motion_done_ && target.gripper != Cmd::GRIPPER_KEEP) {
-      if (target.moves_arm()) update([&](Status&) { commanded_ = target.joints; });
-      target.mode = Cmd::MODE_GRIPPER_ONLY;
-    }
-    requeue(std::move(target));
-  };
-  const auto record_executed = [&] {
-    attempts_ = 0;
-    update([&](Status& s) {
-      s.last_executed_sequence = target.sequence;
-      s.speed = speed_percent_ / 100.0;
-      if (target.mode == Cmd::MODE_STOP) commanded_.reset();
-      if (target.moves_arm()) commanded_ = target.joints;
-      if (target.mode == Cmd::MODE_HOME) commanded_.reset();
-      if (target.gripper == Cmd::GRIPPER_OPEN) s.gripper = Status::GRIPPER_OPEN;
-      if (target.gripper == Cmd::GRIPPER_CLOSE) s.gripper = Status::GRIPPER_CLOSED;
-      if (s.state == Status::STATE_ERROR) s.state = Status::STATE_MOVING;
-      s.error.clear();
-    });
-  };
+  const auto reached_controller = [&] { return speed_done && link_->delivered(); };
   try {
-    const int percent = std::clamp(static_cast<int>(std::lround(target.speed * 100)), 1, 100);
-    if (target.mode != Cmd::MODE_STOP && percent != speed_percent_) {
-      link_->command(rapl::speed(percent), settings_.timing.reply_timeout);
-      speed_percent_ = percent;
-    }
+    send_speed(target);
     speed_done = true;
     act(target);
   } catch (const ControllerError& e) {
-    update([&](Status& s) {
-      s.last_executed_sequence = target.sequence;  // delivered: it ran, and the controller refused
-      s.last_rejected_sequence = target.sequence;
-      s.rejection_reason = std::string("controller: ") + e.what();
-      s.error = s.rejection_reason;
-      s.state = Status::STATE_ERROR;
-    });
+    record_refusal(target, e.what());
     read_joints();
     return;
   } catch (const LinkError& e) {
-    if (!speed_done || !link_->delivered()) {
-      requeue_rest();
+    if (!reached_controller()) {
+      requeue_rest(std::move(target));
       throw;
     }
     spdlog::warn("command {}: {} (it reached the controller; not sent again)", target.sequence,
                  e.what());
   } catch (const LinkDown&) {
-    if (!speed_done || !link_->delivered()) {
-      requeue_rest();
+    if (!reached_controller()) {
+      requeue_rest(std::move(target));
     } else {
-      record_executed();  // it reached the controller before the line went: not sent again
+      record_executed(target);  // it reached the controller before the line went: not sent again
     }
     throw;
   }
-  record_executed();
+  record_executed(target);
   read_joints();
-  const double total = seconds_since(start);
+  const double total = clock_.now() - start;
   const double inside = static_cast<TimedStream&>(*stream_).inside() - inside_before;
   update([&](Status& s) {
     s.interaction_time = total;
@@ -269,8 +281,7 @@ std::optional<ArmTarget> ArmDriver::wait_for_work(std::stop_token stop) {
   std::unique_lock lock(mutex_);
   const bool moving = status_.state == Status::STATE_MOVING;
   const double poll = moving ? settings_.moving_poll : settings_.idle_poll;
-  wake_.wait_for(lock, stop, std::chrono::duration<double>(poll),
-                 [&] { return pending_.has_value(); });
+  clock_.wait_until(lock, clock_.now() + poll, [&] { return pending_.has_value(); }, stop);
   std::optional<ArmTarget> target = std::move(pending_);
   pending_.reset();
   return target;

@@ -11,7 +11,6 @@
 ///     driver.submit(command);                       // from the bus thread
 ///     auto [status, version] = driver.status();     // publish when version changes
 
-#include <condition_variable>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -21,6 +20,7 @@
 #include "arm_driver/byte_stream.hpp"
 #include "arm_driver/c550_link.hpp"
 #include "arm_driver/command_validator.hpp"
+#include "common/clock.hpp"
 #include "stereograsp/arm_status_t.hpp"
 
 namespace sg::arm {
@@ -34,13 +34,19 @@ struct DriverSettings {
   double reconnect_max = 2.0;       ///< ... up to this
   double arrived_tolerance = 1e-3;  ///< rad: within this of the target, the arm is IDLE
   int max_attempts = 3;             ///< sends of an undelivered command before it is rejected
+  /// The fastest the driver lets the arm move, a fraction of the joints' maximum speeds: the
+  /// SPEED sent is min(command's speed, max_speed) in whole percent, 1..100 (a lab's cap).
+  double max_speed = 1.0;
 };
 
 using DeviceOpener = std::function<std::unique_ptr<ByteStream>()>;
 
 class ArmDriver {
  public:
-  ArmDriver(ArmGeometry geometry, DriverSettings settings, DeviceOpener open_device);
+  /// Validates with `geometry`, opens the line with `open_device` (again after it is lost), and
+  /// takes all time from `clock`: the machine's in sg-arm-driver, a SimulatedClock in trials.
+  ArmDriver(ArmGeometry geometry, DriverSettings settings, DeviceOpener open_device,
+            Clock& clock = system_clock());
 
   /// Validates a command (bus thread) and puts it in the slot, or records its rejection.
   void submit(const stereograsp::arm_cmd_t& command);
@@ -59,7 +65,11 @@ class ArmDriver {
   bool connect(std::stop_token stop);
   void disconnect(const std::string& why);
   void execute(ArmTarget target);
+  void send_speed(const ArmTarget& target);
   void act(const ArmTarget& target);
+  void requeue_rest(ArmTarget target);
+  void record_executed(const ArmTarget& target);
+  void record_refusal(const ArmTarget& target, const std::string& why);
   void read_joints();
   std::optional<ArmTarget> wait_for_work(std::stop_token stop);
   void requeue(ArmTarget target);
@@ -72,12 +82,11 @@ class ArmDriver {
   std::unique_ptr<ByteStream> stream_;
   std::unique_ptr<C550Link> link_;
   int speed_percent_ = -1;  ///< the controller's SPEED, -1 before the first
-  int attempts_ = 0;
-  bool motion_done_ = false;  ///< this interaction's motion command has been delivered        ///<
-                              ///< sends of the pending command that did not reach the controller
+  int attempts_ = 0;          ///< sends of the pending command that did not reach the controller
+  bool motion_done_ = false;  ///< this interaction's motion command has been delivered
 
+  Clock& clock_;
   mutable std::mutex mutex_;
-  std::condition_variable_any wake_;
   std::optional<ArmTarget> pending_;
   std::optional<Joints> commanded_;  ///< the last joint target sent
   Joints current_ = Joints::Zero();

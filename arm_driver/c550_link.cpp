@@ -2,14 +2,17 @@
 
 #include <spdlog/spdlog.h>
 
-#include <thread>
 
 namespace sg::arm {
 
 using namespace aci;
 
-C550Link::C550Link(ByteStream& line, int slave, LinkTiming timing)
-    : line_(line), slave_(slave), timing_(timing) {
+namespace {
+double seconds(milliseconds ms) { return std::chrono::duration<double>(ms).count(); }
+}  // namespace
+
+C550Link::C550Link(ByteStream& line, int slave, LinkTiming timing, Clock& clock)
+    : line_(line), slave_(slave), timing_(timing), clock_(clock) {
   slave_byte(slave);  // validates 1..127
 }
 
@@ -159,19 +162,19 @@ void C550Link::write_memory(uint8_t memtype, uint16_t segment, uint16_t offset,
 void C550Link::leave_command_mode() {
   const uint8_t interrupt = rapl::CTRL_C;
   send({&interrupt, 1});
-  std::this_thread::sleep_for(timing_.session_settle);
+  clock_.sleep_for(seconds(timing_.session_settle));
   const std::string help = "HELP\r";
   send({reinterpret_cast<const uint8_t*>(help.data()), help.size()});
-  drain(std::chrono::seconds(2));
+  drain(2.0);
   const uint8_t leave[] = {rapl::CTRL_Z, rapl::CTRL_Z};
   send(leave);
-  std::this_thread::sleep_for(timing_.session_settle);
+  clock_.sleep_for(seconds(timing_.session_settle));
   line_.discard_input();
 }
 
-void C550Link::drain(std::chrono::steady_clock::duration at_most) {
-  const auto give_up = std::chrono::steady_clock::now() + at_most;
-  while (std::chrono::steady_clock::now() < give_up && line_.read_byte(timing_.byte_timeout)) {
+void C550Link::drain(double at_most) {
+  const double give_up = clock_.now() + at_most;
+  while (clock_.now() < give_up && line_.read_byte(timing_.byte_timeout)) {
     ++stats_.bytes_read;
   }
 }
@@ -179,10 +182,10 @@ void C550Link::drain(std::chrono::steady_clock::duration at_most) {
 void C550Link::open_session() {
   leave_command_mode();
   read_memory(kMemSession, 0, 0, 1);
-  std::this_thread::sleep_for(timing_.session_settle);
+  clock_.sleep_for(seconds(timing_.session_settle));
   const uint8_t interrupt = rapl::CTRL_C;
   send({&interrupt, 1});
-  std::this_thread::sleep_for(timing_.session_settle);
+  clock_.sleep_for(seconds(timing_.session_settle));
   line_.discard_input();
   command("NOH", timing_.reply_timeout);
 }
@@ -263,8 +266,8 @@ void C550Link::resynchronise() {
   const uint8_t interrupt = rapl::CTRL_C;
   send({&interrupt, 1});
   std::string tail;
-  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(2);
-  while (std::chrono::steady_clock::now() < give_up) {
+  const double give_up = clock_.now() + 2.0;
+  while (clock_.now() < give_up) {
     const auto byte = line_.read_byte(timing_.byte_timeout);
     if (!byte) return;  // quiet: whatever was in flight has ended
     tail.push_back(static_cast<char>(*byte));

@@ -18,6 +18,7 @@
 #include "arm_driver/aci.hpp"
 #include "arm_driver/byte_stream.hpp"
 #include "arm_driver/rapl.hpp"
+#include "common/clock.hpp"
 
 namespace sg::arm {
 
@@ -57,7 +58,11 @@ struct LinkStats {
 
 class C550Link {
  public:
-  explicit C550Link(ByteStream& line, int slave = 1, LinkTiming timing = {});
+  /// Speaks to controller `slave` over `line`, waiting (settle times, drains) on `clock`; the
+  /// line's own read time-outs are the line's (a SerialPort's are real, a simulated line's run
+  /// the simulated clock).
+  explicit C550Link(ByteStream& line, int slave = 1, LinkTiming timing = {},
+                    Clock& clock = system_clock());
 
   /// `'R', s+0x20, ENQ` until the controller answers `'R', s+0x20, ACK` (enquiry_tries).
   void enquire();
@@ -100,7 +105,7 @@ class C550Link {
 
  private:
   void send(std::span<const uint8_t> bytes);
-  void drain(std::chrono::steady_clock::duration at_most);
+  void drain(double at_most_seconds);
   /// One byte as it came: the ACI layer is binary, so 0x11 and 0x13 are data there.
   uint8_t expect_raw(const char* what, milliseconds timeout);
   /// One byte of RAPL-II text, XON/XOFF dropped (c550-aci.md: "dropped on read").
@@ -115,6 +120,7 @@ class C550Link {
   int slave_;
   LinkTiming timing_;
   LinkStats stats_;
+  Clock& clock_;
   bool delivered_ = false;
 };
 

@@ -1,7 +1,7 @@
-// How often the whole system grasps the moving ball (issue 8): many grasp trials in simulated
-// time, in one process, through the live system's libraries (system/grasp_trial.hpp: rendered frames,
-// vision, the Burg predictor at 4 Hz, the grasp state machine, the C550 model behind the driver's
-// timing). Per trial, drawn from --seed: the ball's phase, circle radius 0.10-0.15 m, speed
+// How often the whole system grasps the moving ball (issues 8, 14): many grasp trials in simulated
+// time, in one process, composed of the product's own parts (system/grasp_trial.hpp: rendered
+// frames, sg-vision's stereo step, the Burg predictor at 4 Hz and its OBJECT_TRAJECTORY, sg-grasp's
+// node, sg-arm-driver's core speaking RAPL-II bytes to the C550 emulator on a simulated line). Per trial, drawn from --seed: the ball's phase, circle radius 0.10-0.15 m, speed
 // 0.5-2 rpm, Y drift 0-0.01 m/s (the paper's back-and-forth, reversing every 20 s), the grasp
 // command at a time after the warm-up, and a total occlusion from 1 s before the grasp command,
 // 3-4 s long, so it covers the close. Each trial runs with prediction and with --no-prediction
@@ -22,6 +22,7 @@
 #include <cstdio>
 #include <numbers>
 #include <opencv2/core.hpp>
+#include <spdlog/spdlog.h>
 #include <random>
 #include <thread>
 #include <vector>
@@ -42,7 +43,7 @@ struct Options {
   double warmup = 40.0;
   double grasp_window = 20.0;
   double frame_rate = 4.0;
-  double vision_sigma = 0.0004;  // per axis: rendered + vision measured 0.7 mm 3D RMS
+  double pixel_sigma = 0.25;  // px per axis, --no-render (the camera model)
 };
 
 /// Trial `index`'s draw: the same for both modes.
@@ -61,7 +62,7 @@ sg::system::TrialParams draw_trial(const Options& o, int index) {
   if (occluded) p.sim.occlusion.episodes = {{p.grasp_time - 1.0, duration}};
   p.render = !o.no_render;
   p.frame_rate = o.frame_rate;
-  p.vision_sigma = o.vision_sigma;
+  p.pixel_sigma = o.pixel_sigma;
   return p;
 }
 
@@ -119,7 +120,7 @@ ModeSummary run_mode(const Options& o, bool prediction) {
 void print_table(const Options& o, const std::vector<ModeSummary>& modes) {
   std::printf("\ngrasp_success: %d trials, seed %llu, %s, %d thread(s), occluded fraction %.2f\n",
               o.trials, static_cast<unsigned long long>(o.seed),
-              o.no_render ? "truth + noise (--no-render)" : "rendered frames + vision", o.threads,
+              o.no_render ? "camera model (--no-render)" : "rendered frames + vision", o.threads,
               o.occluded_fraction);
   std::printf(
       "\n| mode | success (held after lift) | machine agrees | closed | refused | miss p50 | "
@@ -158,7 +159,8 @@ int main(int argc, char** argv) {
   app.add_option("--seed", o.seed, "seeds every trial's draw");
   app.add_option("--threads", o.threads, "trials run in parallel")->check(CLI::PositiveNumber);
   app.add_flag("--no-render", o.no_render,
-               "no images and vision: triangulated truth + Gaussian noise (--vision-sigma)");
+               "no images or blob tracking: a camera model (projected truth + pixel noise, "
+               "--pixel-sigma) into the product's triangulation");
   app.add_flag("--no-prediction", o.only_baseline,
                "only the baseline (aim at the last measurement)");
   app.add_flag("--no-baseline", o.skip_baseline, "only with prediction");
@@ -170,9 +172,10 @@ int main(int argc, char** argv) {
   app.add_option("--grasp-window", o.grasp_window,
                  "s: the grasp command is drawn uniformly in [warmup, warmup + this)");
   app.add_option("--frame-rate", o.frame_rate, "Hz: stereo frames (render + vision)");
-  app.add_option("--vision-sigma", o.vision_sigma, "m per axis, --no-render");
+  app.add_option("--pixel-sigma", o.pixel_sigma, "px per axis, --no-render");
   CLI11_PARSE(app, argc, argv);
   cv::setNumThreads(1);  // the trials are the parallelism
+  spdlog::set_level(o.verbose ? spdlog::level::info : spdlog::level::err);  // the driver's log
   std::vector<ModeSummary> modes;
   if (!o.only_baseline) modes.push_back(run_mode(o, true));
   if (!o.skip_baseline || o.only_baseline) modes.push_back(run_mode(o, false));

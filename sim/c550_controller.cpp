@@ -134,6 +134,7 @@ void C550Controller::abort(double t) {
 
 void C550Controller::open(double t) {
   check_time(t, "open");
+  if (holding_) released_at_ = tool_pose(t).translation();
   holding_ = false;
   start_stroke(params_.gripper_open_width, t);
 }
@@ -144,6 +145,7 @@ void C550Controller::close(double t, const std::optional<Eigen::Vector3d>& ball_
   const bool near = ball_centre && ball_centre->allFinite() &&
                     (tool_pose(t).translation() - *ball_centre).norm() <= params_.grasp_tolerance;
   if (!holding_ && near && gripper_opening(t) > ball_width) holding_ = true;
+  closes_.push_back({t, tool_pose(t).translation(), ball_centre, holding_});
   start_stroke(
       holding_ ? std::max(ball_width, params_.gripper_closed_width) : params_.gripper_closed_width,
       t);

@@ -89,6 +89,20 @@ class C550Controller {
   double gripper_opening(double t) const;
   /// True from a CLOSE that grasped the ball until the next OPEN.
   bool holding() const { return holding_; }
+  /// A CLOSE as it happened: when, where the tool centre point was, the ball centre it was given,
+  /// and whether the controller then held the ball.
+  struct CloseRecord {
+    double t = 0;
+    Eigen::Vector3d tcp = Eigen::Vector3d::Zero();
+    std::optional<Eigen::Vector3d> ball;
+    bool holding = false;
+  };
+  /// Every CLOSE so far, in order (the trials' miss distance).
+  const std::vector<CloseRecord>& closes() const { return closes_; }
+  /// Where the tool centre point was when an OPEN last let a held ball go; nullopt before.
+  const std::optional<Eigen::Vector3d>& released_at() const { return released_at_; }
+  /// When the last accepted arm motion (MA, MOVE, JOINT, READY) started; 0 before any.
+  double last_motion_start() const { return motion_.start; }
   /// True while the arm or the gripper is moving at `t`.
   bool moving(double t) const { return t < settle_time(); }
   /// When the current arm motion and gripper stroke have both ended (FINISH answers then).
@@ -164,6 +178,8 @@ class C550Controller {
   Motion motion_;
   Stroke stroke_;
   bool holding_ = false;
+  std::vector<CloseRecord> closes_;
+  std::optional<Eigen::Vector3d> released_at_;
   double last_command_time_ = 0;
   std::mt19937 rng_;
   std::map<uint16_t, std::vector<uint8_t>> segments_;

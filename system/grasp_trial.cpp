@@ -1,388 +1,293 @@
 #include "system/grasp_trial.hpp"
 
-#include <algorithm>
-#include <array>
-#include <limits>
-#include <map>
-#include <memory>
 #include <optional>
 #include <random>
 #include <stdexcept>
+#include <stop_token>
+#include <vector>
 
-#include "arm_driver/command_validator.hpp"
-#include "grasp/grasp_messages.hpp"
-#include "vision/triangulation.hpp"
+#include "common/change_or_period.hpp"
+#include "grasp/grasp_node.hpp"
+#include "predictor/trajectory_message.hpp"
+#include "sim/c550_emulator.hpp"
+#include "sim/occlusion.hpp"
+#include "sim/stereo_rig.hpp"
+#include "stereograsp/grasp_command_t.hpp"
+#include "system/simulated_clock.hpp"
+#include "system/simulated_line.hpp"
+#include "vision/stereo_step.hpp"
 
 namespace sg::system {
-using namespace sg::sim;  // NOLINT: the trial is rewritten on the product's parts
 namespace {
 
-using Cmd = stereograsp::arm_cmd_t;
-constexpr double kNever = std::numeric_limits<double>::infinity();
+using stereograsp::arm_cmd_t;
+using stereograsp::point3_t;
 
-int64_t utime_at(double t) { return kTrialEpochUtime + std::llround(t * 1e6); }
-double time_of(int64_t utime) { return static_cast<double>(utime - kTrialEpochUtime) * 1e-6; }
+/// sg-grasp's loop handles the bus for 10 ms, then polls the node.
+constexpr double kGraspLoopPeriod = 0.010;
+/// sg-arm-driver's loop handles the bus for 5 ms, then publishes ARM_STATUS when due.
+constexpr double kDriverLoopPeriod = 0.005;
 
-/// One controller action of an interaction, in the order sg-arm-driver sends them.
-enum class Step { kMove, kReady, kAbort, kOpen, kClose };
+/// A message as its subscribers receive it: encoded and decoded as on the bus.
+template <class T>
+T over_bus(const T& message) {
+  std::vector<uint8_t> bytes(static_cast<size_t>(message.getEncodedSize()));
+  if (message.encode(bytes.data(), 0, static_cast<int>(bytes.size())) < 0)
+    throw std::logic_error("a trial message does not encode");
+  T received;
+  if (received.decode(bytes.data(), 0, static_cast<int>(bytes.size())) < 0)
+    throw std::logic_error("a trial message does not decode");
+  return received;
+}
 
-/// A trial: the world (ball, controller), the driver model, vision, predictor and machine.
+void check(const TrialParams& p) {
+  if (!(p.frame_rate > 0) || !(p.arm_status_rate > 0) || !(p.grasp_status_rate > 0) ||
+      !(p.timeout > 0) || !(p.bus_latency > 0) || !(p.pixel_sigma >= 0) || !(p.grasp_time >= 0))
+    throw std::invalid_argument("grasp trial: rates, times and latencies must be positive");
+}
+
+/// The world, the five processes' cores, and the wiring between them on one clock.
 class Trial {
  public:
-  explicit Trial(const TrialParams& p)
-      : p_(p),
-        controller_(p.arm, p.c550),
-        validator_(p.arm),
-        machine_(p.arm, p.grasp, 1),
-        predictor_(p.predictor),
-        noise_rng_(p.seed * 0x9E3779B97F4A7C15ULL + 17) {
-    if (!(p.frame_rate > 0) || !(p.status_rate > 0) || !(p.timeout > 0) || !(p.w2_time >= 0) ||
-        !(p.bus_latency > 0))
-      throw std::invalid_argument("grasp trial: rates, timeout and latencies must be positive");
-    p_.sim.frame_rate = p.frame_rate;
-    scenario_ = make_scenario(p_.sim.scenario);
-    if (p_.render) {
-      camera_ = std::make_unique<CameraSimulator>(p_.sim);
-      const cv::Size size(p_.sim.rig.width, p_.sim.rig.height);
-      trackers_.emplace_back(p_.tracker, size);
-      trackers_.emplace_back(p_.tracker, size);
-    }
-    polled_ = controller_.joints(0);
-    view_.connected = true;
-    set_view_joints();
-  }
-
-  TrialResult run() {
-    result_.grasp_time = p_.grasp_time;
-    machine_.on_command(grasp::GraspCommand::kTrack, 0.0, utime_at(0));
-    pump(0);
-    int64_t frame = 0, tick = 0, shell = 0;
-    bool grasp_sent = false;
-    double stop_at = p_.grasp_time + p_.timeout;
-    for (;;) {
-      const double t_frame = static_cast<double>(frame) / p_.frame_rate;
-      const double t_tick = static_cast<double>(tick) / p_.status_rate;
-      const double t_shell = static_cast<double>(shell) * kShellPeriod;
-      const double t_grasp = grasp_sent ? kNever : p_.grasp_time;
-      const double t_poll = current_ ? kNever : next_poll_;
-      const double t = std::min(
-          {step_time_, end_time_, t_poll, change_at_, t_tick, t_frame, t_grasp, t_shell, stop_at});
-      if (t >= stop_at) {
-        now_ = stop_at;
-        break;
-      }
-      now_ = t;
-      if (step_time_ <= t) execute_step(t);
-      if (end_time_ <= t) finish_interaction(t);
-      if (!current_ && next_poll_ <= t) poll(t);
-      if (change_at_ <= t) deliver_status(t);
-      if (t_tick <= t) deliver_status(t), ++tick;
-      if (t_frame <= t) capture(frame++, t);
-      if (t_grasp <= t) {
-        grasp_sent = true;
-        machine_.on_command(grasp::GraspCommand::kGrasp, 0.0, utime_at(t));
-        if (machine_.status().activity != grasp::GraspActivity::kGrasping) {
-          result_.refused = true;
-          break;
-        }
-      }
-      if (t_shell <= t) ++shell;
-      pump(t);
-      if (grasp_sent && !outcome_seen_ && machine_.status().outcome != grasp::GraspOutcome::kNone) {
-        outcome_seen_ = true;
-        stop_at = std::min(stop_at, t + p_.settle_after_outcome);
-      }
-    }
-    return finish();
-  }
+  explicit Trial(const TrialParams& p);
+  TrialResult run();
 
  private:
-  /// sg-grasp asks the machine for a request every 10 ms.
-  static constexpr double kShellPeriod = 0.01;
-
   // ---- The world ----
+  Eigen::Vector3d ball_at(double t) const;
+  sim::ArmState arm_state(double t) const;
+  /// One stereo frame through the cameras and sg-vision: OBJECT_POSITION, or none without a
+  /// calibration.
+  point3_t see(int64_t index, double t);
+  point3_t model_camera(double t, const Eigen::Vector3d& truth);
 
-  /// The ball's true centre at t: on its path, in the gripper, or where it was let go.
-  Eigen::Vector3d ball_at(double t) const {
-    if (controller_.holding()) return controller_.tool_pose(t).translation();
-    if (dropped_at_) return *dropped_at_;
-    return scenario_->position(t);
+  // ---- The processes ----
+  void capture(int64_t index, double t);            // sg-camera-sim + sg-vision
+  void on_position(const point3_t& position);       // sg-predictor, and sg-grasp's subscription
+  void grasp_loop(double t);                        // sg-grasp's loop
+  void driver_loop(double t);                       // sg-arm-driver's loop
+  void operator_command(int8_t command, double t);  // sg-grasp-ctl
+  template <class F>
+  void deliver(F&& f) {
+    clock_.at(clock_.now() + p_.bus_latency, std::forward<F>(f));
   }
 
-  ArmState arm_state(double t) const {
-    ArmState a;
-    a.present = true;
-    const Eigen::Isometry3d tool = controller_.tool_pose(t);
-    a.tool_position = tool.translation();
-    a.tool_rpy = arm::rpy_from_rotation(tool.rotation());
-    a.gripper_opening = controller_.gripper_opening(t);
-    a.holding_object = controller_.holding();
-    return a;
-  }
-
-  /// A stereo frame: rendered and measured by the vision library, or truth plus noise.
-  void capture(int64_t index, double t) {
-    ++result_.frames;
-    std::optional<Eigen::Vector3d> measured;
-    Eigen::Vector3d truth;
-    if (camera_) {
-      camera_->render(index, arm_state(t), frame_);
-      truth = frame_.ball;
-      vision::Observation o[2];
-      for (int i = 0; i < 2; ++i) o[i] = trackers_[static_cast<size_t>(i)].track(frame_.image[i]);
-      if (o[0].found && o[1].found) {  // as sg-vision: OBJECT_POSITION visible when both see it
-        const auto tri = vision::triangulate({&camera_->camera(0), &camera_->camera(1)},
-                                             {{o[0].blob.centroid.x, o[0].blob.centroid.y},
-                                              {o[1].blob.centroid.x, o[1].blob.centroid.y}});
-        if (tri.position.allFinite()) measured = tri.position;
-      }
-    } else {
-      truth = ball_at(t);
-      if (!fully_occluded_at(p_.sim.occlusion, t)) {
-        std::normal_distribution<double> n(0.0, p_.vision_sigma);
-        measured = truth + Eigen::Vector3d(n(noise_rng_), n(noise_rng_), n(noise_rng_));
-      }
-    }
-    const int64_t utime = utime_at(t);
-    if (measured) {
-      ++result_.visible;
-      last_seen_ = t;
-      if (!controller_.holding()) {
-        vision_sq_ += (*measured - truth).squaredNorm();
-        ++vision_n_;
-      }
-    }
-    machine_.on_measurement(measured, utime);
-    pump(t);
-    const predictor::Measurement m{utime, measured.has_value(),
-                                   measured.value_or(Eigen::Vector3d::Zero())};
-    for (const predictor::Forecast& f : predictor_.add(m)) {
-      grasp::PredictedPath path;
-      path.utime = f.utime;
-      path.start_utime = f.utime + f.period_us;
-      path.period_us = f.period_us;
-      path.points = f.positions;
-      path.lost = f.status == predictor::TrackStatus::kLost;
-      ++result_.trajectories;
-      machine_.on_trajectory(path, f.source_utime, utime);
-      pump(t);
-    }
-  }
-
-  // ---- sg-grasp's shell ----
-
-  void pump(double t) {
-    for (int i = 0; i < 4; ++i) {  // one request in flight (abort aside): never more than a few
-      std::optional<grasp::ArmRequest> r = machine_.take_request(utime_at(t));
-      if (!r) return;
-      submit(*r, t);
-    }
-  }
-
-  void deliver_status(double t) {
-    if (change_at_ <= t) change_at_ = kNever;
-    machine_.on_arm_status(view_, utime_at(t));
-  }
-
-  /// ARM_STATUS is also sent on every change; it reaches the machine a bus hop later.
-  void status_changed(double t) { change_at_ = std::min(change_at_, t + p_.bus_latency); }
-
-  // ---- sg-arm-driver ----
-
-  void set_view_joints() {
-    view_.joints = polled_;
-    view_.tool = arm::forward_kinematics(p_.arm, polled_).translation();
-  }
-
-  /// The driver's W2: the joints, and whether the arm is still on its way to the commanded ones.
-  void read_joints(double t) {
-    polled_ = controller_.joints(t);
-    set_view_joints();
-    const bool moving =
-        commanded_ && (polled_ - *commanded_).cwiseAbs().maxCoeff() > kArrivedTolerance;
-    if (!view_.error) view_.moving = moving;
-    next_poll_ = t + (moving ? 0.1 : 0.5);
-  }
-
-  void poll(double t) { read_joints(t); }
-
-  /// A request from the machine: validated on arrival, then the latest-wins slot.
-  void submit(const grasp::ArmRequest& r, double t) {
-    ++result_.requests;
-    const Cmd c = grasp::to_arm_cmd(r, utime_at(t));
-    const arm::Joints reference =
-        pending_ && pending_->moves_arm() ? pending_->joints : commanded_.value_or(polled_);
-    arm::ValidationResult v = validator_.validate(c, reference);
-    if (!v.target) {
-      ++result_.rejected;
-      view_.last_rejected_sequence = r.sequence;
-      result_.arm_rejection = v.reason;
-      status_changed(t);
-      return;
-    }
-    requests_[r.sequence] = r;
-    pending_ = std::move(v.target);
-    if (!current_) start_next(t);
-    status_changed(t);
-  }
-
-  void start_next(double t) {
-    if (!pending_) return;
-    current_ = std::move(pending_);
-    pending_.reset();
-    ++result_.interactions;
-    interaction_start_ = t;
-    controller_error_.clear();
-    view_.moving = true;  // the driver's state is MOVING for the whole interaction
-    view_.error = false;
-    const int percent = std::clamp(static_cast<int>(std::lround(current_->speed * 100)), 1, 100);
-    if (current_->mode != Cmd::MODE_STOP && percent != speed_percent_) {
-      (void)controller_.set_speed(percent);  // SPEED does not wait for the delay
-      speed_percent_ = percent;
-    }
-    steps_.clear();
-    if (current_->mode == Cmd::MODE_STOP) {
-      steps_.push_back(Step::kAbort);  // the driver sends ABORT alone
-    } else {
-      if (current_->moves_arm()) steps_.push_back(Step::kMove);
-      if (current_->mode == Cmd::MODE_HOME) steps_.push_back(Step::kReady);
-      if (current_->gripper == Cmd::GRIPPER_OPEN) steps_.push_back(Step::kOpen);
-      if (current_->gripper == Cmd::GRIPPER_CLOSE) steps_.push_back(Step::kClose);
-    }
-    next_step_ = 0;
-    schedule_step(t);
-    status_changed(t);
-  }
-
-  /// Motion commands act one interaction delay after they are sent; ABORT at once.
-  void schedule_step(double t) {
-    if (next_step_ >= steps_.size()) {
-      step_time_ = kNever;
-      end_time_ = t + p_.w2_time;
-      return;
-    }
-    step_time_ = steps_[next_step_] == Step::kAbort ? t : t + controller_.interaction_delay();
-  }
-
-  void execute_step(double t) {
-    const Step step = steps_[next_step_++];
-    CommandResult r;
-    switch (step) {
-      case Step::kMove:
-        if (result_.closed && controller_.holding()) result_.lifted = true;
-        r = controller_.move_joints(current_->joints, t);
-        if (!r) result_.lifted = false;
-        break;
-      case Step::kReady:
-        r = controller_.ready(t);
-        break;
-      case Step::kAbort:
-        controller_.abort(t);
-        break;
-      case Step::kOpen:
-        if (controller_.holding()) dropped_at_ = controller_.tool_pose(t).translation();
-        controller_.open(t);
-        break;
-      case Step::kClose:
-        record_close(t);
-        break;
-    }
-    if (!r) {  // the controller refused: the driver sends nothing more of this command
-      controller_error_ = "controller: " + r.error;
-      next_step_ = steps_.size();
-    }
-    schedule_step(t);
-  }
-
-  void record_close(double t) {
-    const Eigen::Vector3d ball = ball_at(t);
-    if (!result_.closed) {
-      result_.closed = true;
-      result_.close_time = t;
-      result_.miss_distance = (controller_.tool_pose(t).translation() - ball).norm();
-      result_.track_age = t - last_seen_;
-      if (auto it = requests_.find(current_->sequence); it != requests_.end()) {
-        result_.aim_error = (it->second.position - ball).norm();
-        if (it->second.target_utime != 0)
-          result_.timing_error = t - time_of(it->second.target_utime);
-      }
-    }
-    controller_.close(t, ball);
-  }
-
-  void finish_interaction(double t) {
-    end_time_ = kNever;
-    const arm::ArmTarget& target = *current_;
-    view_.last_executed_sequence = target.sequence;
-    if (!controller_error_.empty()) {
-      ++result_.rejected;
-      view_.last_rejected_sequence = target.sequence;
-      view_.error = true;
-      view_.moving = false;
-      result_.arm_rejection = controller_error_;
-    } else {
-      view_.error = false;
-      if (target.mode == Cmd::MODE_STOP || target.mode == Cmd::MODE_HOME) commanded_.reset();
-      if (target.moves_arm()) commanded_ = target.joints;
-    }
-    read_joints(t);
-    view_.interaction_time = t - interaction_start_;
-    current_.reset();
-    status_changed(t);
-    start_next(t);
-  }
-
-  TrialResult finish() {
-    const grasp::GraspStatusView& s = machine_.status();
-    result_.end_time = now_;
-    result_.outcome = s.outcome;
-    result_.final_state = s.state;
-    result_.message = s.message;
-    result_.success = controller_.holding() && result_.lifted;
-    result_.machine_success = s.outcome == grasp::GraspOutcome::kSuccess;
-    result_.machine_agrees = result_.machine_success == result_.success;
-    if (vision_n_ > 0) result_.vision_rms = std::sqrt(vision_sq_ / vision_n_);
-    return result_;
-  }
-
-  static constexpr double kArrivedTolerance = 1e-3;  // rad, DriverSettings::arrived_tolerance
+  void record_close();
+  TrialResult finish();
 
   TrialParams p_;
-  std::unique_ptr<Scenario> scenario_;
-  std::unique_ptr<CameraSimulator> camera_;
-  std::vector<vision::BlobTracker> trackers_;
-  StereoFrame frame_;
-  C550Controller controller_;
-  arm::CommandValidator validator_;
-  grasp::GraspMachine machine_;
-  predictor::TrajectoryPredictor predictor_;
+  SimulatedClock clock_;
+  std::unique_ptr<sim::Scenario> scenario_;
+  std::array<vision::CameraModel, 2> cameras_;
+  std::unique_ptr<sim::CameraSimulator> camera_;
+  sim::StereoFrame frame_;
   std::mt19937_64 noise_rng_;
-  std::optional<Eigen::Vector3d> dropped_at_;
+  sim::C550Controller controller_;
+  sim::C550Emulator emulator_;
+  SimulatedLine line_;
+  arm::ArmDriver driver_;
+  vision::StereoStep vision_;
+  predictor::TrajectoryPredictor predictor_;
+  grasp::GraspNode node_;
+  ChangeOrPeriod arm_status_rule_;
+  std::stop_source stop_;
 
-  // The driver model.
-  grasp::ArmView view_;
-  arm::Joints polled_ = arm::Joints::Zero();
-  std::optional<arm::Joints> commanded_;
-  std::optional<arm::ArmTarget> pending_;
-  std::optional<arm::ArmTarget> current_;
-  std::vector<Step> steps_;
-  size_t next_step_ = 0;
-  std::string controller_error_;
-  int speed_percent_ = -1;
-  double interaction_start_ = 0;
-  double step_time_ = kNever;
-  double end_time_ = kNever;
-  double next_poll_ = 0;
-  double change_at_ = kNever;
-  std::map<int64_t, grasp::ArmRequest> requests_;
-
-  double now_ = 0;
+  int64_t operator_sequence_ = 0;
+  std::optional<arm_cmd_t> close_command_;  ///< the last ARM_COMMAND that closes the hand
+  int64_t last_rejected_ = -1;
   double last_seen_ = std::nan("");
-  bool outcome_seen_ = false;
   double vision_sq_ = 0;
   int vision_n_ = 0;
+  bool outcome_seen_ = false;
   TrialResult result_;
 };
+
+vision::StereoCalibration true_calibration(const std::array<vision::CameraModel, 2>& cameras) {
+  vision::StereoCalibration c;
+  c.left = cameras[0];
+  c.right = cameras[1];
+  c.source = "grasp trial: the simulator's true cameras";
+  return c;
+}
+
+Trial::Trial(const TrialParams& p)
+    : p_((check(p), p)),
+      clock_(kTrialEpochUtime),
+      scenario_(sim::make_scenario(p.sim.scenario)),
+      cameras_(sim::make_rig(p.sim.rig)),
+      noise_rng_(p.seed * 0x9E3779B97F4A7C15ULL + 17),
+      controller_(p.arm, p.c550),
+      emulator_(controller_, p.driver.slave),
+      line_(emulator_, clock_,
+            {p.baud, [this](double t) { emulator_.set_ball_centre(ball_at(t)); }}),
+      driver_(p.arm, p.driver, [this] { return line_.connect(); }, clock_),
+      vision_(p.tracker, cv::Size(p.sim.rig.width, p.sim.rig.height), true_calibration(cameras_)),
+      predictor_(p.predictor),
+      node_(p.arm, p.grasp, kTrialEpochUtime, 1.0 / p.grasp_status_rate),
+      arm_status_rule_(1.0 / p.arm_status_rate) {
+  p_.sim.frame_rate = p.frame_rate;
+  if (p_.render) camera_ = std::make_unique<sim::CameraSimulator>(p_.sim);
+}
+
+Eigen::Vector3d Trial::ball_at(double t) const {
+  if (controller_.holding()) return controller_.tool_pose(t).translation();
+  if (controller_.released_at()) return *controller_.released_at();  // stays where let go
+  return scenario_->position(t);
+}
+
+sim::ArmState Trial::arm_state(double t) const {
+  sim::ArmState a;
+  a.present = true;
+  const Eigen::Isometry3d tool = controller_.tool_pose(t);
+  a.tool_position = tool.translation();
+  a.tool_rpy = arm::rpy_from_rotation(tool.rotation());
+  a.gripper_opening = controller_.gripper_opening(t);
+  a.holding_object = controller_.holding();
+  return a;
+}
+
+point3_t Trial::model_camera(double t, const Eigen::Vector3d& truth) {
+  std::array<vision::Observation, 2> o;
+  std::normal_distribution<double> noise(0.0, p_.pixel_sigma);
+  for (size_t i = 0; i < 2; ++i) {
+    const auto px = cameras_[i].project(truth);
+    o[i].found = px && !sim::fully_occluded_at(p_.sim.occlusion, t);
+    if (o[i].found)
+      o[i].blob.centroid = {px->x() + noise(noise_rng_), px->y() + noise(noise_rng_)};
+  }
+  return vision::position_of(o, *vision_.calibration(), clock_.utime_at(t));
+}
+
+point3_t Trial::see(int64_t index, double t) {
+  if (!camera_) return model_camera(t, ball_at(t));
+  camera_->render(index, arm_state(t), frame_);
+  return *vision_.process(frame_.image[0], frame_.image[1], index, clock_.utime_at(t)).position;
+}
+
+void Trial::capture(int64_t index, double t) {
+  ++result_.frames;
+  const Eigen::Vector3d truth = camera_ ? Eigen::Vector3d::Zero() : ball_at(t);
+  const point3_t position = see(index, t);
+  const Eigen::Vector3d seen_truth = camera_ ? frame_.ball : truth;
+  if (position.visible) {
+    ++result_.visible;
+    last_seen_ = t;
+    if (!controller_.holding()) {
+      const Eigen::Vector3d m(position.position[0], position.position[1], position.position[2]);
+      vision_sq_ += (m - seen_truth).squaredNorm();
+      ++vision_n_;
+    }
+  }
+  deliver([this, m = over_bus(position)](double) { on_position(m); });
+}
+
+void Trial::on_position(const point3_t& position) {
+  node_.on_position(position);
+  for (const predictor::Forecast& f : predictor_.add(predictor::measurement_of(position))) {
+    ++result_.trajectories;
+    deliver([this, m = over_bus(predictor::to_trajectory_t(f, p_.predictor))](double) {
+      node_.on_trajectory(m, clock_.utime());
+    });
+  }
+}
+
+void Trial::grasp_loop(double) {
+  const grasp::GraspNode::Output out = node_.poll(clock_.utime());
+  if (!out.arm_command) return;
+  ++result_.requests;
+  if (out.arm_command->gripper == arm_cmd_t::GRIPPER_CLOSE) close_command_ = out.arm_command;
+  deliver([this, m = over_bus(*out.arm_command)](double) { driver_.submit(m); });
+}
+
+void Trial::driver_loop(double t) {
+  auto [status, version] = driver_.status();
+  if (!arm_status_rule_.due(version, t)) return;
+  status.utime = clock_.utime();
+  if (status.last_rejected_sequence != last_rejected_) {
+    last_rejected_ = status.last_rejected_sequence;
+    ++result_.rejected;
+    result_.arm_rejection = status.rejection_reason;
+  }
+  deliver([this, m = over_bus(status)](double) { node_.on_arm_status(m, clock_.utime()); });
+}
+
+void Trial::operator_command(int8_t command, double t) {
+  stereograsp::grasp_command_t c{};
+  c.utime = clock_.utime_at(t);
+  c.sequence = ++operator_sequence_;
+  c.command = command;
+  c.standoff = 0;  // sg-grasp's own
+  c.sender = "sg-grasp-ctl";
+  deliver([this, m = over_bus(c)](double) {
+    const grasp::CommandRecord& answer = node_.on_command(m, clock_.utime());
+    if (m.command == stereograsp::grasp_command_t::COMMAND_GRASP &&
+        answer.reply.result != grasp::CommandResult::kAccepted) {
+      result_.refused = true;
+      stop_.request_stop();
+    }
+  });
+}
+
+TrialResult Trial::run() {
+  result_.grasp_time = p_.grasp_time;
+  clock_.every(1.0 / p_.frame_rate, [this, k = int64_t{0}](double t) mutable { capture(k++, t); });
+  clock_.every(kGraspLoopPeriod, [this](double t) {
+    grasp_loop(t);
+    if (!outcome_seen_ && node_.machine().status().outcome != grasp::GraspOutcome::kNone &&
+        clock_.now() > p_.grasp_time) {
+      outcome_seen_ = true;
+      clock_.at(t + p_.settle_after_outcome, [this](double) { stop_.request_stop(); });
+    }
+  });
+  clock_.every(kDriverLoopPeriod, [this](double t) { driver_loop(t); });
+  operator_command(stereograsp::grasp_command_t::COMMAND_TRACK, 0.0);
+  clock_.at(p_.grasp_time, [this](double t) {
+    operator_command(stereograsp::grasp_command_t::COMMAND_GRASP, t);
+  });
+  clock_.at(p_.grasp_time + p_.timeout, [this](double) { stop_.request_stop(); });
+  driver_.run(stop_.get_token());  // every wait of the driver runs the world
+  return finish();
+}
+
+void Trial::record_close() {
+  const auto& closes = controller_.closes();
+  if (closes.empty()) return;
+  const sim::C550Controller::CloseRecord& c = closes.front();
+  const Eigen::Vector3d ball = c.ball.value_or(Eigen::Vector3d::Constant(std::nan("")));
+  result_.closed = true;
+  result_.close_time = c.t;
+  result_.miss_distance = (c.tcp - ball).norm();
+  result_.track_age = c.t - last_seen_;
+  if (close_command_) {
+    const Eigen::Vector3d aim(close_command_->position[0], close_command_->position[1],
+                              close_command_->position[2]);
+    result_.aim_error = (aim - ball).norm();
+    if (close_command_->target_utime != 0)
+      result_.timing_error = c.t - clock_.time_of(close_command_->target_utime);
+  }
+  const double rise = controller_.tool_pose(clock_.now()).translation().z() - c.tcp.z();
+  result_.lifted = controller_.holding() && rise >= 0.5 * p_.grasp.lift;
+}
+
+TrialResult Trial::finish() {
+  record_close();
+  const grasp::GraspStatusView& s = node_.machine().status();
+  result_.end_time = clock_.now();
+  result_.outcome = s.outcome;
+  result_.final_state = s.state;
+  result_.message = s.message;
+  result_.success = controller_.holding() && result_.lifted;
+  result_.machine_success = s.outcome == grasp::GraspOutcome::kSuccess;
+  result_.machine_agrees = result_.machine_success == result_.success;
+  for (const std::string& line : emulator_.executed_commands()) {
+    const std::string verb = line.substr(0, line.find(' '));
+    if (verb == "MA" || verb == "READY" || verb == "OPEN" || verb == "CLOSE" || verb == "ABORT")
+      ++result_.interactions;
+  }
+  result_.serial_bytes = line_.bytes_written();
+  if (vision_n_ > 0) result_.vision_rms = std::sqrt(vision_sq_ / vision_n_);
+  return result_;
+}
 
 }  // namespace
 

@@ -73,5 +73,45 @@ TEST(GraspTrial, SameSeedSameResult) {
   EXPECT_EQ(a.vision_rms, b.vision_rms);
 }
 
+// The trial runs the product's driver: its speed cap (DriverSettings::max_speed, 5 % of the
+// joints' speeds) slows the real arm model, and the grasp that held at full speed now misses.
+TEST(GraspTrial, DriverSpeedCapReachesTheTrial) {
+  const TrialResult full = run_grasp_trial(quick_trial());
+  TrialParams p = quick_trial();
+  p.driver.max_speed = 0.05;
+  const TrialResult capped = run_grasp_trial(p);
+  ASSERT_TRUE(full.success) << full.message;
+  EXPECT_FALSE(capped.success) << capped.message;
+  EXPECT_GT(capped.miss_distance, full.miss_distance);
+}
+
+// The trial runs the product's stereo step: a tracker that ignores regions under 10^6 px never
+// finds the ball, OBJECT_POSITION is never visible, and sg-grasp refuses the grasp for want of a
+// track.
+TEST(GraspTrial, VisionRuleReachesTheTrial) {
+  TrialParams p = quick_trial();
+  p.render = true;
+  p.grasp_time = 8.0;
+  p.sim.occlusion.episodes.clear();
+  p.timeout = 2.0;
+  const TrialResult seen = run_grasp_trial(p);
+  p.tracker.min_area = 1'000'000;
+  const TrialResult blind = run_grasp_trial(p);
+  EXPECT_GT(seen.visible, seen.frames / 2);
+  EXPECT_FALSE(seen.refused) << seen.message;
+  EXPECT_EQ(blind.visible, 0);
+  EXPECT_TRUE(blind.refused) << blind.message;
+}
+
+// Every ARM_COMMAND crosses the real driver: the emulator received motion lines, and the bytes
+// on the line are those of RAPL-II lines (an MA with six joints is some 50 characters).
+TEST(GraspTrial, CommandsCrossTheSerialLine) {
+  const TrialResult r = run_grasp_trial(quick_trial());
+  EXPECT_GT(r.requests, 10);
+  EXPECT_GT(r.interactions, 10);
+  EXPECT_LE(r.interactions, r.requests + 2);  // latest wins: never more lines than commands
+  EXPECT_GT(r.serial_bytes, 30u * static_cast<uint64_t>(r.interactions));
+}
+
 }  // namespace
 }  // namespace sg::system
