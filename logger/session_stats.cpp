@@ -260,6 +260,13 @@ struct EpisodeState {
   ErrorStats vs_truth, after;
 };
 
+// Keeps the first problem of a channel, with where it was in the log.
+void note_problem(ChannelSummary& s, const std::string& what, int64_t offset, int size) {
+  if (!s.first_problem.empty()) return;
+  s.first_problem = what + " (event at offset " + std::to_string(offset) + ", " +
+                    std::to_string(size) + " bytes)";
+}
+
 }  // namespace
 
 struct SessionStats::Impl {
@@ -559,6 +566,108 @@ struct SessionStats::Impl {
     last_outcome = g.outcome;
     have_grasp = true;
   }
+
+  // One decoded message of each kind, to what it feeds (kinds without figures: nothing).
+  void on_message(const std::string& channel, int64_t recv, const stereograsp::image_t& msg) {
+    latency_of(channel, "utime", recv, msg.utime);
+  }
+  void on_message(const std::string& channel, int64_t recv, const stereograsp::blob_t& msg) {
+    on_blob(channel, recv, msg);
+  }
+  void on_message(const std::string& channel, int64_t recv, const stereograsp::point3_t& msg) {
+    if (channel == "OBJECT_POSITION") on_position(recv, msg);
+    if (channel == "GROUND_TRUTH") on_truth(recv, msg);
+  }
+  void on_message(const std::string&, int64_t recv, const stereograsp::trajectory_t& msg) {
+    on_trajectory(recv, msg);
+  }
+  void on_message(const std::string&, int64_t recv, const stereograsp::arm_cmd_t& msg) {
+    on_arm_command(recv, msg);
+  }
+  void on_message(const std::string&, int64_t recv, const stereograsp::arm_status_t& msg) {
+    on_arm_status(recv, msg);
+  }
+  void on_message(const std::string& channel, int64_t recv,
+                  const stereograsp::grasp_command_t& msg) {
+    latency_of(channel, "utime", recv, msg.utime);
+    ++grasp.commands[command_name(msg.command)];
+  }
+  void on_message(const std::string&, int64_t recv, const stereograsp::grasp_status_t& msg) {
+    on_grasp_status(recv, msg);
+  }
+  void on_message(const std::string& channel, int64_t recv,
+                  const stereograsp::sim_arm_state_t& msg) {
+    latency_of(channel, "utime", recv, msg.utime);
+  }
+  template <class T>
+  void on_message(const std::string&, int64_t, const T&) {}
+
+  // The session's span and event count; its first event sets t0.
+  void count_event(int64_t recv) {
+    if (!started) {
+      started = true;
+      t0 = recv;
+      first = recv;
+    }
+    last = std::max(last, recv);
+    ++events;
+  }
+
+  // One more event on `channel`: its count, bytes, and the gap since its previous event.
+  ChannelState& count_arrival(const std::string& channel, int64_t recv, int size) {
+    ChannelState& cs = channels[channel];
+    ChannelSummary& s = cs.s;
+    if (s.count == 0) {
+      s.name = channel;
+      s.expected_type = expected_type_of_channel(channel);
+      s.first_recv_utime = recv;
+    } else {
+      const int64_t gap = recv - cs.last_recv;
+      cs.gaps.add(seconds(gap));
+      if (gap > cs.largest_gap) {
+        cs.largest_gap = gap;
+        cs.largest_gap_end = recv;
+      }
+    }
+    ++s.count;
+    s.bytes += size;
+    s.last_recv_utime = recv;
+    cs.last_recv = recv;
+    return cs;
+  }
+
+  // A fingerprint of no known type: an unknown channel is listed, a known one has a problem.
+  void on_unknown_type(const std::string& channel, ChannelState& cs, const uint8_t* data, int size,
+                       int64_t offset) {
+    ChannelSummary& s = cs.s;
+    ++s.unknown_fingerprint;
+    if (s.type.empty()) s.type = "?";
+    if (!s.expected_type.empty()) {
+      note_problem(s, "unknown fingerprint", offset, size);
+      return;
+    }
+    UnknownChannel& u = unknown[channel];
+    if (u.count == 0) {
+      u.name = channel;
+      if (size >= 8) u.fingerprint = hex64(fingerprint(data));
+    }
+    ++u.count;
+  }
+
+  // Decodes `data` exactly as the type at `type_index` of MessageTypes and, when `feed`, passes
+  // it on; false when it does not decode exactly.
+  bool decode_and_feed(const std::string& channel, int64_t recv, int type_index,
+                       const uint8_t* data, int size, bool feed) {
+    bool ok = false;
+    int index = 0;
+    for_each_message_type([&]<class T>() {
+      if (index++ != type_index) return;
+      T msg{};
+      ok = decode_exact(data, size, msg);
+      if (ok && feed) on_message(channel, recv, msg);
+    });
+    return ok;
+  }
 };
 
 SessionStats::SessionStats(StatsOptions options) : impl_(std::make_unique<Impl>()) {
@@ -584,104 +693,33 @@ SessionStats::~SessionStats() = default;
 void SessionStats::add(const std::string& channel, int64_t recv, const uint8_t* data, int size,
                        int64_t offset) {
   Impl& m = *impl_;
-  if (!m.started) {
-    m.started = true;
-    m.t0 = recv;
-    m.first = recv;
-  }
-  m.last = std::max(m.last, recv);
-  ++m.events;
-
+  m.count_event(recv);
   if (channel == "LCM_SELF_TEST") {
     UnknownChannel& u = m.internal[channel];
     u.name = channel;
     ++u.count;
     return;
   }
-
-  ChannelState& cs = m.channels[channel];
+  ChannelState& cs = m.count_arrival(channel, recv, size);
   ChannelSummary& s = cs.s;
-  if (s.count == 0) {
-    s.name = channel;
-    s.expected_type = expected_type_of_channel(channel);
-    s.first_recv_utime = recv;
-  } else {
-    const int64_t gap = recv - cs.last_recv;
-    cs.gaps.add(seconds(gap));
-    if (gap > cs.largest_gap) {
-      cs.largest_gap = gap;
-      cs.largest_gap_end = recv;
-    }
-  }
-  ++s.count;
-  s.bytes += size;
-  s.last_recv_utime = recv;
-  cs.last_recv = recv;
-
   const TypeEntry* type = find_type(data, size);
-  auto describe = [&](const std::string& what) {
-    if (!s.first_problem.empty()) return;
-    s.first_problem = what + " (event at offset " + std::to_string(offset) + ", " +
-                      std::to_string(size) + " bytes)";
-  };
   if (type == nullptr) {
-    ++s.unknown_fingerprint;
-    if (s.type.empty()) s.type = "?";
-    if (s.expected_type.empty()) {
-      UnknownChannel& u = m.unknown[channel];
-      if (u.count == 0) {
-        u.name = channel;
-        if (size >= 8) u.fingerprint = hex64(fingerprint(data));
-      }
-      ++u.count;
-    } else {
-      describe("unknown fingerprint");
-    }
+    m.on_unknown_type(channel, cs, data, size, offset);
     return;
   }
   if (s.type.empty() || s.type == "?") s.type = type->name;
   if (!s.expected_type.empty() && type->name != s.expected_type) {
     ++s.wrong_type;
-    describe("a " + type->name + " where " + s.expected_type + " belongs");
+    note_problem(s, "a " + type->name + " where " + s.expected_type + " belongs", offset, size);
     return;
   }
-
   // Decode exactly, then feed the figures when the channel is one of the session's own.
-  bool ok = false;
   const bool session_channel = !s.expected_type.empty() && channel.rfind("BUS_CHECK_", 0) != 0;
-  int index = 0;
-  for_each_message_type([&]<class T>() {
-    if (index++ != type->index) return;
-    T msg{};
-    ok = decode_exact(data, size, msg);
-    if (!ok || !session_channel) return;
-    if constexpr (std::is_same_v<T, stereograsp::image_t>) {
-      m.latency_of(channel, "utime", recv, msg.utime);
-    } else if constexpr (std::is_same_v<T, stereograsp::blob_t>) {
-      m.on_blob(channel, recv, msg);
-    } else if constexpr (std::is_same_v<T, stereograsp::point3_t>) {
-      if (channel == "OBJECT_POSITION") m.on_position(recv, msg);
-      if (channel == "GROUND_TRUTH") m.on_truth(recv, msg);
-    } else if constexpr (std::is_same_v<T, stereograsp::trajectory_t>) {
-      m.on_trajectory(recv, msg);
-    } else if constexpr (std::is_same_v<T, stereograsp::arm_cmd_t>) {
-      m.on_arm_command(recv, msg);
-    } else if constexpr (std::is_same_v<T, stereograsp::arm_status_t>) {
-      m.on_arm_status(recv, msg);
-    } else if constexpr (std::is_same_v<T, stereograsp::grasp_command_t>) {
-      m.latency_of(channel, "utime", recv, msg.utime);
-      ++m.grasp.commands[command_name(msg.command)];
-    } else if constexpr (std::is_same_v<T, stereograsp::grasp_status_t>) {
-      m.on_grasp_status(recv, msg);
-    } else if constexpr (std::is_same_v<T, stereograsp::sim_arm_state_t>) {
-      m.latency_of(channel, "utime", recv, msg.utime);
-    }
-  });
-  if (ok) {
+  if (m.decode_and_feed(channel, recv, type->index, data, size, session_channel)) {
     ++s.decoded;
   } else {
     ++s.wrong_size;
-    describe("wrong size for " + type->name);
+    note_problem(s, "wrong size for " + type->name, offset, size);
   }
 }
 
