@@ -668,6 +668,64 @@ struct SessionStats::Impl {
     });
     return ok;
   }
+
+  // Per channel: rate, median period, the largest gap and gaps over 3x the median; the unknown
+  // and LCM's own channels; the problem totals.
+  void summarize_channels(SessionSummary& s) const {
+    s.channels.clear();
+    s.wrong_size = s.wrong_type = 0;
+    for (const auto& [name, cs] : channels) {
+      ChannelSummary c = cs.s;
+      if (c.count >= 2 && c.last_recv_utime > c.first_recv_utime)
+        c.rate_hz =
+            static_cast<double>(c.count - 1) / seconds(c.last_recv_utime - c.first_recv_utime);
+      if (cs.gaps.count() > 0) {
+        c.median_period_s = cs.gaps.percentile(0.5);
+        c.largest_gap_s = seconds(cs.largest_gap);
+        c.largest_gap_at_s = t(cs.largest_gap_end);
+        c.gaps_over_3x = cs.gaps.count_above(3 * c.median_period_s);
+      }
+      if (c.type.empty()) c.type = "?";
+      s.wrong_size += c.wrong_size;
+      s.wrong_type += c.wrong_type;
+      s.channels.push_back(std::move(c));
+    }
+    s.unknown.clear();
+    for (const auto& [name, u] : unknown) s.unknown.push_back(u);
+    s.lcm_internal.clear();
+    for (const auto& [name, u] : internal) s.lcm_internal.push_back(u);
+  }
+
+  // Per horizon: the errors against measurements and truth, and predictions never matched.
+  void summarize_prediction(SessionSummary& s) const {
+    s.prediction.clear();
+    for (size_t hi = 0; hi < options.horizons.size(); ++hi) {
+      HorizonSummary h;
+      h.h = options.horizons[hi];
+      h.predictions = predictions[hi];
+      h.vs_measurement = quantiles(measured.error[hi].hist);
+      h.vs_truth = quantiles(truth.error[hi].hist);
+      h.unmatched_measurement =
+          measured.unmatched[hi] + static_cast<int64_t>(measured.pending[hi].size());
+      h.unmatched_truth = truth.unmatched[hi] + static_cast<int64_t>(truth.pending[hi].size());
+      s.prediction.push_back(h);
+    }
+  }
+
+  // Occlusion episodes; one still open at the end closes at the last position.
+  void summarize_occlusions(SessionSummary& s) {
+    if (episode_open) close_episode(last_position_utime, true);
+    s.occlusions.count = episode_count;
+    s.occlusions.total_s = episode_total;
+    s.occlusions.longest_s = episode_longest;
+    s.occlusions.episodes.clear();
+    for (const EpisodeState& ep : episodes) {
+      OcclusionEpisode e = ep.e;
+      e.vs_truth = quantiles(ep.vs_truth.hist);
+      e.after_vs_measurement = quantiles(ep.after.hist);
+      s.occlusions.episodes.push_back(e);
+    }
+  }
 };
 
 SessionStats::SessionStats(StatsOptions options) : impl_(std::make_unique<Impl>()) {
@@ -739,40 +797,15 @@ void SessionStats::finish() {
   s.first_utime = m.first;
   s.last_utime = m.last;
   s.duration_s = m.started ? seconds(m.last - m.first) : 0;
-
-  s.channels.clear();
-  s.wrong_size = s.wrong_type = 0;
-  for (auto& [name, cs] : m.channels) {
-    ChannelSummary c = cs.s;
-    if (c.count >= 2 && c.last_recv_utime > c.first_recv_utime)
-      c.rate_hz =
-          static_cast<double>(c.count - 1) / seconds(c.last_recv_utime - c.first_recv_utime);
-    if (cs.gaps.count() > 0) {
-      c.median_period_s = cs.gaps.percentile(0.5);
-      c.largest_gap_s = seconds(cs.largest_gap);
-      c.largest_gap_at_s = m.t(cs.largest_gap_end);
-      c.gaps_over_3x = cs.gaps.count_above(3 * c.median_period_s);
-    }
-    if (c.type.empty()) c.type = "?";
-    s.wrong_size += c.wrong_size;
-    s.wrong_type += c.wrong_type;
-    s.channels.push_back(std::move(c));
-  }
-  s.unknown.clear();
-  for (auto& [name, u] : m.unknown) s.unknown.push_back(u);
-  s.lcm_internal.clear();
-  for (auto& [name, u] : m.internal) s.lcm_internal.push_back(u);
-
+  m.summarize_channels(s);
   s.cameras.clear();
   for (auto& [name, c] : m.cameras) {
     CameraSummary cam = c.s;
     if (cam.frames > 0) cam.detection_rate = static_cast<double>(cam.detected) / cam.frames;
     s.cameras.push_back(cam);
   }
-
   s.triangulation = m.triangulation;
   s.triangulation.residual_px = quantiles(m.residual);
-
   s.latency.clear();
   plots_.latency_ms.clear();
   for (auto& [name, l] : m.latency) {
@@ -781,33 +814,8 @@ void SessionStats::finish() {
     s.latency.push_back(ls);
     plots_.latency_ms[name] = l.hist.to_plot();
   }
-
-  s.prediction.clear();
-  for (size_t hi = 0; hi < m.options.horizons.size(); ++hi) {
-    HorizonSummary h;
-    h.h = m.options.horizons[hi];
-    h.predictions = m.predictions[hi];
-    h.vs_measurement = quantiles(m.measured.error[hi].hist);
-    h.vs_truth = quantiles(m.truth.error[hi].hist);
-    h.unmatched_measurement =
-        m.measured.unmatched[hi] + static_cast<int64_t>(m.measured.pending[hi].size());
-    h.unmatched_truth = m.truth.unmatched[hi] + static_cast<int64_t>(m.truth.pending[hi].size());
-    s.prediction.push_back(h);
-  }
-
-  // Occlusion episodes; one still open at the end closes at the last position.
-  if (m.episode_open) m.close_episode(m.last_position_utime, true);
-  s.occlusions.count = m.episode_count;
-  s.occlusions.total_s = m.episode_total;
-  s.occlusions.longest_s = m.episode_longest;
-  s.occlusions.episodes.clear();
-  for (EpisodeState& ep : m.episodes) {
-    OcclusionEpisode e = ep.e;
-    e.vs_truth = quantiles(ep.vs_truth.hist);
-    e.after_vs_measurement = quantiles(ep.after.hist);
-    s.occlusions.episodes.push_back(e);
-  }
-
+  m.summarize_prediction(s);
+  m.summarize_occlusions(s);
   s.arm = m.arm;
   s.arm.interaction_s = quantiles(m.interaction);
   s.grasp = m.grasp;
