@@ -171,7 +171,7 @@ void Trial::capture(int64_t index, double t) {
   const Eigen::Vector3d seen_truth = camera_ ? frame_.ball : truth;
   if (position.visible) {
     ++result_.visible;
-    last_seen_ = t;
+    if (controller_.closes().empty()) last_seen_ = t;  // the last sighting before the CLOSE
     if (!controller_.holding()) {
       const Eigen::Vector3d m(position.position[0], position.position[1], position.position[2]);
       vision_sq_ += (m - seen_truth).squaredNorm();
