@@ -1,7 +1,7 @@
 #pragma once
 
-/// The names of grasp_status_t's enumerations (the paper's figure 4), one list for the grasp
-/// machine, sg-grasp-ctl and sg-report. Values outside a list give "unknown".
+/// The names of grasp_status_t's enumerations (the paper's figure 4) and command results, one list
+/// for the grasp machine, sg-grasp-ctl and sg-report. Values outside a list give "unknown".
 ///
 ///     std::printf("%s\n", sg::grasp_state_name(status.state));   // "q3 hand closed"
 
@@ -31,6 +31,17 @@ inline const char* grasp_action_name(int action) {
 inline const char* grasp_outcome_name(int outcome) {
   static const char* const names[] = {"none", "success", "failed", "aborted"};
   return outcome >= 0 && outcome <= 3 ? names[outcome] : "unknown";
+}
+
+/// RESULT_NONE .. RESULT_REFUSED_STATE: what became of the last GRASP_COMMAND.
+inline const char* grasp_command_result_name(int result) {
+  static const char* const names[] = {"none",
+                                      "accepted",
+                                      "refused: not newer",
+                                      "refused: unknown command",
+                                      "refused: bad argument",
+                                      "refused: state"};
+  return result >= 0 && result <= 5 ? names[result] : "unknown";
 }
 
 }  // namespace sg

@@ -77,7 +77,8 @@ template <class M, class V>
 void visit_fields(M& m, V& v) {
   SG_FIELD(utime); SG_FIELD(source_utime); SG_FIELD(state); SG_FIELD(activity);
   SG_FIELD(last_action); SG_FIELD(target); SG_FIELD(target_utime); SG_FIELD(outcome);
-  SG_FIELD(message);
+  SG_FIELD(message); SG_FIELD(command_sequence); SG_FIELD(command_result);
+  SG_FIELD(command_reason);
 }
 template <class M, class V>
   requires std::same_as<std::remove_const_t<M>, stereograsp::sim_arm_state_t>

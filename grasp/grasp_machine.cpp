@@ -12,9 +12,9 @@
 
 namespace sg::grasp {
 
-using arm::rpy_from_rotation;
 using arm::forward_kinematics;
 using arm::motion_time;
+using arm::rpy_from_rotation;
 namespace {
 
 using Cmd = stereograsp::arm_cmd_t;
@@ -50,6 +50,10 @@ const char* to_string(GraspOutcome outcome) {
   return grasp_outcome_name(static_cast<int>(outcome));
 }
 
+const char* to_string(CommandResult result) {
+  return grasp_command_result_name(static_cast<int>(result));
+}
+
 const char* to_string(GraspCommand command) {
   switch (command) {
     case GraspCommand::kTrack:
@@ -75,90 +79,108 @@ GraspMachine::GraspMachine(ArmGeometry geometry, GraspSettings settings, int64_t
 // ---------------------------------------------------------------------------------------------
 // Inputs.
 
-void GraspMachine::on_command(GraspCommand command, double standoff, int64_t now) {
+CommandReply GraspMachine::on_command(GraspCommand command, double standoff, int64_t now) {
   update(now);
+  const std::string where =
+      std::string(" in ") + to_string(status_.state) + " (" + to_string(status_.activity) + ")";
+  switch (command) {
+    case GraspCommand::kTrack:
+      return track(standoff, where);
+    case GraspCommand::kGrasp:
+      return grasp(where, now);
+    case GraspCommand::kRelease:
+      return release(where);
+    case GraspCommand::kAbort:
+      return abort(where);
+    case GraspCommand::kHome:
+      return home(where);
+  }
+  return refuse_command(CommandResult::kRefusedUnknownCommand,
+                        "unknown command " + std::to_string(static_cast<int>(command)));
+}
+
+CommandReply GraspMachine::track(double standoff, const std::string& where) {
   const GraspState state = status_.state;
   const GraspActivity activity = status_.activity;
-  const std::string where =
-      std::string(" in ") + to_string(state) + " (" + to_string(activity) + ")";
-  switch (command) {
-    case GraspCommand::kTrack: {
-      if (state != GraspState::kHandOpened || activity == GraspActivity::kGrasping ||
-          activity == GraspActivity::kBackingOff) {
-        refuse("track refused" + where +
-               (state == GraspState::kHandOpened ? "" : ": release the object first"));
-        return;
-      }
-      if (standoff != 0) {
-        if (!(std::isfinite(standoff) && standoff > 0)) {
-          refuse("track: stand-off " + fixed(standoff, 3) + " m refused (must be > 0); kept " +
-                 fixed(settings_.standoff, 3) + " m");
-          return;
-        }
-        settings_.standoff = standoff;
-      }
-      status_.activity = GraspActivity::kTracking;
-      home_pending_ = false;
-      set_message("");
-      return;
-    }
-    case GraspCommand::kGrasp: {
-      if (state != GraspState::kHandOpened || activity == GraspActivity::kGrasping ||
-          activity == GraspActivity::kBackingOff) {
-        refuse("grasp refused" + where);
-        return;
-      }
-      if (!track_fresh(now)) {
-        refuse("grasp refused: no fresh track of the object");
-        return;
-      }
-      status_.state = GraspState::kApproaching;
-      status_.activity = GraspActivity::kGrasping;
-      status_.last_action = GraspAction::kApproachObject;
-      status_.outcome = GraspOutcome::kNone;
-      home_pending_ = false;
-      set_message("");
-      return;
-    }
-    case GraspCommand::kRelease: {
-      if (state != GraspState::kHandClosed && state != GraspState::kObjectLifted) {
-        refuse("release ignored" + where + ": the hand holds nothing");
-        return;
-      }
-      if (grasp_in_progress()) abort_grasp("released" + where);
-      status_.activity = GraspActivity::kIdle;
-      lift_pending_ = false;
-      home_pending_ = false;
-      judging_ = false;
-      open_pending_ = true;
-      return;
-    }
-    case GraspCommand::kAbort: {
-      if (grasp_in_progress()) abort_grasp("aborted" + where);
-      status_.state = GraspState::kHandOpened;
-      status_.activity = GraspActivity::kIdle;
-      open_pending_ = false;  // the STOP opens the hand
-      home_pending_ = false;
-      lift_pending_ = false;
-      backoff_pending_ = false;
-      judging_ = false;
-      stop_pending_ = true;
-      return;
-    }
-    case GraspCommand::kHome: {
-      if (activity == GraspActivity::kGrasping || activity == GraspActivity::kBackingOff) {
-        refuse("home refused" + where + ": abort first");
-        return;
-      }
-      const bool home_on_its_way = home_pending_ || (in_flight_ && in_flight_->kind == Kind::kHome);
-      if (activity == GraspActivity::kHoming && home_on_its_way) return;
-      status_.activity = GraspActivity::kHoming;
-      home_pending_ = true;
-      set_message("");
-      return;
-    }
+  if (state != GraspState::kHandOpened || activity == GraspActivity::kGrasping ||
+      activity == GraspActivity::kBackingOff) {
+    return refuse_command(
+        CommandResult::kRefusedState,
+        "track refused" + where +
+            (state == GraspState::kHandOpened ? "" : ": release the object first"));
   }
-  refuse("unknown command " + std::to_string(static_cast<int>(command)));
+  if (standoff != 0) {
+    if (!(std::isfinite(standoff) && standoff > 0)) {
+      return refuse_command(CommandResult::kRefusedBadArgument,
+                            "track: stand-off " + fixed(standoff, 3) +
+                                " m refused (must be > 0); kept " + fixed(settings_.standoff, 3) +
+                                " m");
+    }
+    settings_.standoff = standoff;
+  }
+  status_.activity = GraspActivity::kTracking;
+  if (next_ == NextAction::kHome) next_ = NextAction::kNone;
+  set_message("");
+  return {CommandResult::kAccepted, ""};
+}
+
+CommandReply GraspMachine::grasp(const std::string& where, int64_t now) {
+  const GraspActivity activity = status_.activity;
+  if (status_.state != GraspState::kHandOpened || activity == GraspActivity::kGrasping ||
+      activity == GraspActivity::kBackingOff) {
+    return refuse_command(CommandResult::kRefusedState, "grasp refused" + where);
+  }
+  if (!track_fresh(now)) {
+    return refuse_command(CommandResult::kRefusedState,
+                          "grasp refused: no fresh track of the object");
+  }
+  status_.state = GraspState::kApproaching;
+  status_.activity = GraspActivity::kGrasping;
+  status_.last_action = GraspAction::kApproachObject;
+  status_.outcome = GraspOutcome::kNone;
+  if (next_ == NextAction::kHome) next_ = NextAction::kNone;
+  set_message("");
+  return {CommandResult::kAccepted, ""};
+}
+
+CommandReply GraspMachine::release(const std::string& where) {
+  if (status_.state != GraspState::kHandClosed && status_.state != GraspState::kObjectLifted) {
+    return refuse_command(CommandResult::kRefusedState,
+                          "release ignored" + where + ": the hand holds nothing");
+  }
+  if (grasp_in_progress()) abort_grasp("released" + where);
+  status_.activity = GraspActivity::kIdle;
+  judging_ = false;
+  if (next_ == NextAction::kLift || next_ == NextAction::kHome) next_ = NextAction::kNone;
+  plan(NextAction::kOpen);
+  return {CommandResult::kAccepted, ""};
+}
+
+CommandReply GraspMachine::abort(const std::string& where) {
+  if (grasp_in_progress()) abort_grasp("aborted" + where);
+  status_.state = GraspState::kHandOpened;
+  status_.activity = GraspActivity::kIdle;
+  judging_ = false;
+  next_ = NextAction::kStop;  // the STOP opens the hand: no a0, lift, back-off or home after it
+  return {CommandResult::kAccepted, ""};
+}
+
+CommandReply GraspMachine::home(const std::string& where) {
+  const GraspActivity activity = status_.activity;
+  if (activity == GraspActivity::kGrasping || activity == GraspActivity::kBackingOff) {
+    return refuse_command(CommandResult::kRefusedState, "home refused" + where + ": abort first");
+  }
+  // While homing, the HOME is pending, hidden by a stop or a0 (follow_up()), or in flight.
+  if (activity == GraspActivity::kHoming) return {CommandResult::kAccepted, ""};
+  status_.activity = GraspActivity::kHoming;
+  plan(NextAction::kHome);
+  set_message("");
+  return {CommandResult::kAccepted, ""};
+}
+
+CommandReply GraspMachine::refuse_command(CommandResult result, std::string reason) {
+  refuse(reason);
+  return {result, std::move(reason)};
 }
 
 void GraspMachine::on_trajectory(const PredictedPath& path, int64_t source_utime, int64_t now) {
@@ -211,76 +233,116 @@ void GraspMachine::on_arm_status(const ArmView& arm, int64_t now) {
 std::optional<ArmRequest> GraspMachine::take_request(int64_t now) {
   update(now);
   if (!have_arm_ || !arm_.connected) return std::nullopt;
-
-  if (stop_pending_) {  // abort: at once, even with a request in flight
-    stop_pending_ = false;
-    ArmRequest r = make(Kind::kStop, Cmd::MODE_STOP, Cmd::GRIPPER_OPEN, now);
-    status_.last_action = GraspAction::kOpenHand;
-    status_.target.reset();
-    status_.target_utime = 0;
-    status_.source_utime = 0;
-    return r;
-  }
+  if (next_ == NextAction::kStop) return send_stop(now);  // at once, even with one in flight
   if (in_flight_) return std::nullopt;
-
-  if (open_pending_) {
-    open_pending_ = false;
-    ArmRequest r = make(Kind::kOpenHand, Cmd::MODE_GRIPPER_ONLY, Cmd::GRIPPER_OPEN, now);
-    status_.last_action = GraspAction::kOpenHand;
-    status_.state = GraspState::kHandOpened;
-    return r;
+  switch (next_) {
+    case NextAction::kOpen:
+      return send_open(now);
+    case NextAction::kHome:
+      return send_home(now);
+    case NextAction::kBackoff:
+      return send_backoff(now);
+    case NextAction::kLift:
+      return send_lift(now);
+    case NextAction::kStop:
+    case NextAction::kNone:
+      break;
   }
-
   const GraspActivity activity = status_.activity;
-  const GraspState state = status_.state;
-  if (activity == GraspActivity::kHoming && home_pending_) {
-    home_pending_ = false;
-    ArmRequest r = make(Kind::kHome, Cmd::MODE_HOME, Cmd::GRIPPER_KEEP, now);
-    status_.target.reset();
-    status_.target_utime = 0;
-    status_.source_utime = 0;
-    return r;
+  if (activity == GraspActivity::kGrasping && status_.state == GraspState::kApproaching) {
+    return send_approach(now);
   }
-  if (activity == GraspActivity::kBackingOff && backoff_pending_) {
-    backoff_pending_ = false;
-    Eigen::Vector3d up = arm_.tool + Eigen::Vector3d(0, 0, settings_.backoff);
-    up.z() = std::min(up.z(), geometry_.workspace.max.z());
-    const std::string problem = check_target(up);
-    if (!problem.empty()) {
-      status_.activity = GraspActivity::kIdle;
-      set_message("track lost; back-off refused: " + problem);
-      return std::nullopt;
-    }
-    const Eigen::Vector3d rpy =
-        rpy_from_rotation(forward_kinematics(geometry_, arm_.joints).rotation());
-    return cartesian(Kind::kBackoff, up, rpy, Cmd::GRIPPER_KEEP, now);
-  }
-  if (activity == GraspActivity::kGrasping && state == GraspState::kHandClosed && lift_pending_) {
-    lift_pending_ = false;
-    Eigen::Vector3d up = approach_position_ + Eigen::Vector3d(0, 0, settings_.lift);
-    up.z() = std::min(up.z(), geometry_.workspace.max.z());
-    const std::string problem = check_target(up);
-    if (!problem.empty()) {
-      status_.activity = GraspActivity::kIdle;
-      status_.outcome = GraspOutcome::kFailed;
-      set_message("lift refused: " + problem);
-      return std::nullopt;
-    }
-    status_.last_action = GraspAction::kLiftObject;
-    return cartesian(Kind::kLift, up, approach_rpy_, Cmd::GRIPPER_KEEP, now);
-  }
-  if (activity == GraspActivity::kGrasping && state == GraspState::kApproaching) {
-    std::optional<ArmRequest> r = aim(Kind::kApproach, now);
-    if (r && r->gripper == Cmd::GRIPPER_CLOSE) {
-      status_.state = GraspState::kGrasping;
-      status_.last_action = GraspAction::kCloseHand;
-    }
-    return r;
-  }
-  if (activity == GraspActivity::kTracking && state == GraspState::kHandOpened) {
+  if (activity == GraspActivity::kTracking && status_.state == GraspState::kHandOpened) {
     return aim(Kind::kTrack, now);
   }
   return std::nullopt;
+}
+
+void GraspMachine::plan(NextAction action) {
+  if (action > next_) next_ = action;  // NextAction lists the precedence, lowest first
+}
+
+NextAction GraspMachine::follow_up() const {
+  switch (status_.activity) {
+    case GraspActivity::kBackingOff:
+      return NextAction::kBackoff;
+    case GraspActivity::kHoming:
+      return NextAction::kHome;
+    case GraspActivity::kGrasping:
+      return status_.state == GraspState::kHandClosed ? NextAction::kLift : NextAction::kNone;
+    case GraspActivity::kIdle:
+    case GraspActivity::kTracking:
+      break;
+  }
+  return NextAction::kNone;
+}
+
+ArmRequest GraspMachine::send_stop(int64_t now) {
+  ArmRequest r = make(Kind::kStop, Cmd::MODE_STOP, Cmd::GRIPPER_OPEN, now);
+  status_.last_action = GraspAction::kOpenHand;
+  status_.target.reset();
+  status_.target_utime = 0;
+  status_.source_utime = 0;
+  next_ = follow_up();
+  return r;
+}
+
+ArmRequest GraspMachine::send_open(int64_t now) {
+  ArmRequest r = make(Kind::kOpenHand, Cmd::MODE_GRIPPER_ONLY, Cmd::GRIPPER_OPEN, now);
+  status_.last_action = GraspAction::kOpenHand;
+  // The hand held something (release): q0. In q1 (a grasp asked for before the first a0 went
+  // out) the approach follows.
+  if (status_.state != GraspState::kApproaching) status_.state = GraspState::kHandOpened;
+  next_ = follow_up();
+  return r;
+}
+
+ArmRequest GraspMachine::send_home(int64_t now) {
+  next_ = NextAction::kNone;
+  ArmRequest r = make(Kind::kHome, Cmd::MODE_HOME, Cmd::GRIPPER_KEEP, now);
+  status_.target.reset();
+  status_.target_utime = 0;
+  status_.source_utime = 0;
+  return r;
+}
+
+std::optional<ArmRequest> GraspMachine::send_backoff(int64_t now) {
+  next_ = NextAction::kNone;
+  Eigen::Vector3d up = arm_.tool + Eigen::Vector3d(0, 0, settings_.backoff);
+  up.z() = std::min(up.z(), geometry_.workspace.max.z());
+  const std::string problem = check_target(up);
+  if (!problem.empty()) {
+    status_.activity = GraspActivity::kIdle;
+    set_message("track lost; back-off refused: " + problem);
+    return std::nullopt;
+  }
+  const Eigen::Vector3d rpy =
+      rpy_from_rotation(forward_kinematics(geometry_, arm_.joints).rotation());
+  return cartesian(Kind::kBackoff, up, rpy, Cmd::GRIPPER_KEEP, now);
+}
+
+std::optional<ArmRequest> GraspMachine::send_lift(int64_t now) {
+  next_ = NextAction::kNone;
+  Eigen::Vector3d up = approach_position_ + Eigen::Vector3d(0, 0, settings_.lift);
+  up.z() = std::min(up.z(), geometry_.workspace.max.z());
+  const std::string problem = check_target(up);
+  if (!problem.empty()) {
+    status_.activity = GraspActivity::kIdle;
+    status_.outcome = GraspOutcome::kFailed;
+    set_message("lift refused: " + problem);
+    return std::nullopt;
+  }
+  status_.last_action = GraspAction::kLiftObject;
+  return cartesian(Kind::kLift, up, approach_rpy_, Cmd::GRIPPER_KEEP, now);
+}
+
+std::optional<ArmRequest> GraspMachine::send_approach(int64_t now) {
+  std::optional<ArmRequest> r = aim(Kind::kApproach, now);
+  if (r && r->gripper == Cmd::GRIPPER_CLOSE) {
+    status_.state = GraspState::kGrasping;
+    status_.last_action = GraspAction::kCloseHand;
+  }
+  return r;
 }
 
 std::optional<ArmRequest> GraspMachine::aim(Kind kind, int64_t now) {
@@ -365,18 +427,18 @@ void GraspMachine::answered(bool failed, const std::string& how, int64_t now) {
   switch (done.kind) {
     case Kind::kOpenHand:
       if (failed) {
-        open_pending_ = true;
+        plan(NextAction::kOpen);
         refuse(failure + "a0 open hand" + request);
       }
       return;
     case Kind::kStop:
       if (failed) {
-        stop_pending_ = true;
+        plan(NextAction::kStop);
         refuse(failure + "the stop" + request);
       }
       return;
     case Kind::kHome:
-      if (status_.activity == GraspActivity::kHoming && !home_pending_) {
+      if (status_.activity == GraspActivity::kHoming && next_ != NextAction::kHome) {
         status_.activity = GraspActivity::kIdle;
       }
       if (failed) set_message(failure + "home" + request);
@@ -394,7 +456,7 @@ void GraspMachine::answered(bool failed, const std::string& how, int64_t now) {
         refuse(failure + "the approach" + request + "; trying again");
       } else {
         status_.state = GraspState::kHandClosed;
-        lift_pending_ = true;
+        plan(NextAction::kLift);
       }
       return;
     case Kind::kLift:
@@ -434,7 +496,7 @@ void GraspMachine::update(int64_t now) {
     status_.activity = GraspActivity::kBackingOff;
     status_.outcome = GraspOutcome::kFailed;
     set_message("track lost");
-    backoff_pending_ = true;
+    plan(NextAction::kBackoff);
   }
   judge(now);
 }

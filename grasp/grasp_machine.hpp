@@ -76,6 +76,19 @@
 /// The first request, once the arm is connected, is a0 (open hand). Requests are made only
 /// while ArmView.connected.
 ///
+/// The next one-off request is one value, NextAction, besides the requests that follow the ball
+/// (tracking, the approach), which are computed from the state and activity. Its precedence, in
+/// take_request() and when a second one is asked for before the first is sent: kStop (abort; sent
+/// even with a request in flight) over kOpen (a0: start, release, a retry) over the one the
+/// activity calls for (kBackoff while backing off, kLift in q3 grasping, kHome while homing;
+/// these three exclude each other). A higher one asked for hides a lower one; the lower one is
+/// taken up again from the activity once the higher is sent (abort, then home: STOP, then HOME;
+/// release, then home: OPEN, then HOME). a0 sent in q1 (a grasp asked for before the first a0
+/// went out) leaves q1: the approach follows it.
+///
+/// Every command is answered (on_command()'s CommandReply): accepted, or refused by the state
+/// with the reason (the same text as status().message).
+///
 /// --no-prediction (use_prediction = false): the path is PredictedPath::hold(last visible
 /// measurement) from now on; the track is fresh while that measurement is, or while the
 /// trajectories (whose points are otherwise ignored) say the predictor still tracks the ball,
@@ -85,7 +98,7 @@
 ///     // on each message:                           (now = the shell's clock, us)
 ///     machine.on_arm_status(view_of(arm_status), now);
 ///     machine.on_trajectory(path_from(trajectory), trajectory.source_utime, now);
-///     machine.on_command(GraspCommand::kGrasp, 0.0, now);
+///     CommandReply reply = machine.on_command(GraspCommand::kGrasp, 0.0, now);
 ///     if (std::optional<ArmRequest> r = machine.take_request(now)) publish(to_arm_cmd(*r));
 ///     publish(to_grasp_status(machine.status()));
 
@@ -95,8 +108,8 @@
 #include <optional>
 #include <string>
 
-#include "grasp/interception.hpp"
 #include "arm_driver/kinematics.hpp"
+#include "grasp/interception.hpp"
 
 namespace sg::grasp {
 
@@ -146,6 +159,31 @@ const char* to_string(GraspAction action);
 const char* to_string(GraspOutcome outcome);
 /// "track", "grasp", "release", "abort", "home" ("unknown" for any other value).
 const char* to_string(GraspCommand command);
+
+/// What became of an operator's command (grasp_status_t RESULT_* values). The machine gives
+/// kAccepted, kRefusedBadArgument and kRefusedState; the shell (GraspNode) the others.
+enum class CommandResult : int8_t {
+  kNone = 0,             ///< no command yet
+  kAccepted = 1,         ///< taken up (a command that changes nothing, e.g. home while homing)
+  kRefusedNotNewer = 2,  ///< its sequence is not newer than its sender's last
+  kRefusedUnknownCommand = 3,  ///< not a COMMAND_* value
+  kRefusedBadArgument = 4,     ///< e.g. a stand-off outside 0..0.5 m
+  kRefusedState = 5,           ///< not in this state (a grasp without a fresh track, ...)
+};
+
+/// "none", "accepted", "refused: not newer", "refused: unknown command", "refused: bad
+/// argument", "refused: state".
+const char* to_string(CommandResult result);
+
+/// The machine's answer to a command.
+struct CommandReply {
+  CommandResult result = CommandResult::kNone;
+  std::string reason;  ///< ASCII; why it was refused ("" when accepted)
+};
+
+/// The one-off request the machine sends next (besides tracking and the approach), in order of
+/// precedence: a later value hides an earlier one, see the file comment.
+enum class NextAction : int8_t { kNone, kHome, kLift, kBackoff, kOpen, kStop };
 
 /// What the machine needs of ARM_STATUS.
 struct ArmView {
@@ -208,8 +246,10 @@ class GraspMachine {
   GraspMachine(ArmGeometry geometry, GraspSettings settings, int64_t first_sequence);
 
   /// An operator's command at `now`. `standoff` (m) applies to kTrack; 0 keeps the current one,
-  /// a negative or non-finite one refuses the command.
-  void on_command(GraspCommand command, double standoff, int64_t now);
+  /// a negative or non-finite one refuses the command (kRefusedBadArgument). A command the state
+  /// refuses (the table's "refused" and "ignored") gives kRefusedState and sets status().message
+  /// to the reason.
+  CommandReply on_command(GraspCommand command, double standoff, int64_t now);
 
   /// A new OBJECT_TRAJECTORY (ignored when use_prediction is false).
   void on_trajectory(const PredictedPath& path, int64_t source_utime, int64_t now);
@@ -228,6 +268,9 @@ class GraspMachine {
 
   const GraspStatusView& status() const { return status_; }
 
+  /// The one-off request to send next (kNone: only tracking or the approach, if any).
+  NextAction next_action() const { return next_; }
+
   /// Seconds per controller command, learnt from ArmView.interaction_time (an exponential
   /// average, weight kDelayWeight per interaction; an interaction that sent N motion commands
   /// counts as N delays). default_delay until the first one is measured.
@@ -245,6 +288,28 @@ class GraspMachine {
     Kind kind = Kind::kTrack;
     int64_t sent_utime = 0;
   };
+
+  /// Commands, one function each; each returns its reply. `where`: " in <state> (<activity>)".
+  CommandReply track(double standoff, const std::string& where);
+  CommandReply grasp(const std::string& where, int64_t now);
+  CommandReply release(const std::string& where);
+  CommandReply abort(const std::string& where);
+  CommandReply home(const std::string& where);
+  /// Refuses a command: status().message and the reply's reason say why.
+  CommandReply refuse_command(CommandResult result, std::string reason);
+
+  /// Asks for `action`: it replaces next_ unless next_ has a higher precedence (NextAction order).
+  void plan(NextAction action);
+  /// The one-off request the activity calls for (after a higher one hid it): kBackoff, kLift,
+  /// kHome or kNone.
+  NextAction follow_up() const;
+  /// One request each, for take_request().
+  ArmRequest send_stop(int64_t now);
+  ArmRequest send_open(int64_t now);
+  ArmRequest send_home(int64_t now);
+  std::optional<ArmRequest> send_backoff(int64_t now);
+  std::optional<ArmRequest> send_lift(int64_t now);
+  std::optional<ArmRequest> send_approach(int64_t now);
 
   /// The path to aim with at `now` (fresh, not lost), with its source_utime, or nullopt.
   std::optional<PredictedPath> fresh_path(int64_t now, int64_t* source_utime) const;
@@ -283,11 +348,7 @@ class GraspMachine {
   std::map<int64_t, int> motion_commands_;  ///< sequence -> motion commands, for the delay
   double seen_interaction_time_ = 0;
 
-  bool open_pending_ = true;  ///< a0 to send (start, release)
-  bool stop_pending_ = false;
-  bool home_pending_ = false;
-  bool lift_pending_ = false;
-  bool backoff_pending_ = false;
+  NextAction next_ = NextAction::kOpen;  ///< a0 first
   bool message_is_refusal_ = false;
 
   Eigen::Vector3d approach_position_ = Eigen::Vector3d::Zero();  ///< a1's target, for the lift

@@ -32,7 +32,8 @@ ArmView arm_view_of(const stereograsp::arm_status_t& s) {
   return v;
 }
 
-stereograsp::grasp_status_t to_grasp_status(const GraspStatusView& v, int64_t utime) {
+stereograsp::grasp_status_t to_grasp_status(const GraspStatusView& v, int64_t utime,
+                                            const CommandRecord& command) {
   stereograsp::grasp_status_t m{};
   m.utime = utime;
   m.source_utime = v.source_utime;
@@ -43,6 +44,9 @@ stereograsp::grasp_status_t to_grasp_status(const GraspStatusView& v, int64_t ut
   m.target_utime = v.target_utime;
   m.outcome = static_cast<int8_t>(v.outcome);
   m.message = v.message;
+  m.command_sequence = command.sequence;
+  m.command_result = static_cast<int8_t>(command.reply.result);
+  m.command_reason = command.reply.reason;
   return m;
 }
 

@@ -6,7 +6,7 @@
 ///     machine.on_arm_status(arm_view_of(arm_status), now);
 ///     if (auto path = path_from(trajectory, &why)) machine.on_trajectory(*path, ...);
 ///     bus.publish("ARM_COMMAND", to_arm_cmd(*machine.take_request(now), trajectory.utime));
-///     bus.publish("GRASP_STATUS", to_grasp_status(machine.status(), now));
+///     bus.publish("GRASP_STATUS", to_grasp_status(machine.status(), now, last_command));
 
 #include <optional>
 #include <string>
@@ -27,8 +27,16 @@ stereograsp::arm_cmd_t to_arm_cmd(const ArmRequest& request, int64_t utime,
 /// What the machine needs of an ARM_STATUS.
 ArmView arm_view_of(const stereograsp::arm_status_t& status);
 
-/// The machine's status as GRASP_STATUS (a missing target is NaN).
-stereograsp::grasp_status_t to_grasp_status(const GraspStatusView& view, int64_t utime);
+/// The answer to the last GRASP_COMMAND: its sequence (-1 before any) and the reply.
+struct CommandRecord {
+  int64_t sequence = -1;
+  CommandReply reply;
+};
+
+/// The machine's status as GRASP_STATUS (a missing target is NaN), with the answer to the last
+/// command (command_sequence, command_result, command_reason).
+stereograsp::grasp_status_t to_grasp_status(const GraspStatusView& view, int64_t utime,
+                                            const CommandRecord& command = {});
 
 /// An OBJECT_TRAJECTORY as a path; nullopt, with the reason in `why`, when it is malformed (a
 /// period that is not positive, num_points that disagrees with the points, a point that is not

@@ -1,6 +1,7 @@
-// sg-grasp-ctl: the operator's side of sg-grasp. Sends one GRASP_COMMAND and prints GRASP_STATUS
-// until the machine has taken it up, or, with --wait, until the grasp (or release, or homing) is
-// over; `status` prints the machine's state.
+// sg-grasp-ctl: the operator's side of sg-grasp. Sends one GRASP_COMMAND and waits for the
+// GRASP_STATUS that answers it (command_sequence = its sequence; command_result accepted or
+// refused), or, with --wait, until the grasp (or release, or homing) is over; `status` prints the
+// machine's state. Exit status: 0 done, 3 the grasp failed (--wait), 4 refused, 1 other errors.
 //
 //   sg-grasp-ctl track [--standoff 0.10]      # follow the ball, the gripper above it
 //   sg-grasp-ctl grasp --wait                 # q1 approach, q2 grasp, q3 closed, q4 lifted
@@ -36,24 +37,30 @@ void print(const Status& s) {
   std::fflush(stdout);
 }
 
-/// Handles the bus until `done(status)` or the time-out; returns the last status seen.
+/// Handles the bus until `done(status)` holds for a status received or the time-out; returns the
+/// last status seen.
 std::optional<Status> watch(sg::Bus& bus, double timeout, bool follow,
                             const std::function<bool(const Status&)>& done) {
   std::optional<Status> last;
+  bool finished = false;
   bus.subscribe<Status>("GRASP_STATUS", [&](const Status& s, const sg::ReceiveInfo&) {
+    if (finished) return;
     if (follow && (!last || last->state != s.state || last->activity != s.activity ||
                    last->outcome != s.outcome || last->message != s.message)) {
       print(s);
     }
     last = s;
+    finished = done(s);
   });
   const auto give_up = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout);
-  while (!sg::shutdown_requested() && std::chrono::steady_clock::now() < give_up &&
-         !(last && done(*last))) {
+  while (!sg::shutdown_requested() && std::chrono::steady_clock::now() < give_up && !finished) {
     bus.handle(std::chrono::milliseconds(50));
   }
   return last;
 }
+
+/// Exit code of a command that sg-grasp refused (command_result not RESULT_ACCEPTED).
+constexpr int kRefused = 4;
 
 int send(sg::Bus& bus, int8_t command, double standoff, bool wait, double timeout) {
   Cmd c{};
@@ -63,21 +70,15 @@ int send(sg::Bus& bus, int8_t command, double standoff, bool wait, double timeou
   c.standoff = standoff;
   c.sender = "sg-grasp-ctl";
   bus.publish("GRASP_COMMAND", c);
-  // Done when the machine has moved on: for --wait, until it is idle with the grasp judged.
-  // A command the machine refuses says so at once: "grasp refused: ...", "release ignored ...".
-  const std::string verb = command == Cmd::COMMAND_TRACK     ? "track"
-                           : command == Cmd::COMMAND_GRASP   ? "grasp"
-                           : command == Cmd::COMMAND_RELEASE ? "release"
-                           : command == Cmd::COMMAND_HOME    ? "home"
-                                                             : "abort";
-  const auto refused = [&](const Status& s) {
-    return s.utime >= c.utime &&
-           (s.message.starts_with(verb + " refused") || s.message.starts_with(verb + " ignored"));
-  };
+  // The answer is the first status whose command_sequence is ours; then, for --wait, the
+  // command has run its course: tracking, the grasp judged, or idle.
+  std::optional<int8_t> result;
   const auto finished = [&](const Status& s) {
-    if (s.utime < c.utime) return false;
-    if (refused(s)) return true;
-    if (!wait) return true;
+    if (!result) {
+      if (s.command_sequence != c.sequence) return false;
+      result = s.command_result;
+    }
+    if (*result != Status::RESULT_ACCEPTED || !wait) return true;
     if (command == Cmd::COMMAND_TRACK) return s.activity == Status::ACTIVITY_TRACKING;
     if (command == Cmd::COMMAND_GRASP)
       return s.activity != Status::ACTIVITY_GRASPING && s.outcome != Status::OUTCOME_NONE;
@@ -85,9 +86,15 @@ int send(sg::Bus& bus, int8_t command, double standoff, bool wait, double timeou
   };
   const auto last = watch(bus, timeout, wait, finished);
   if (!last) throw std::runtime_error("no GRASP_STATUS: is sg-grasp running on this bus?");
-  if (!finished(*last)) throw std::runtime_error("no answer within the time-out");
+  if (!result) throw std::runtime_error("sg-grasp did not answer the command within the time-out");
+  if (*result != Status::RESULT_ACCEPTED) {
+    print(*last);
+    std::fprintf(stderr, "sg-grasp-ctl: %s: %s\n", sg::grasp_command_result_name(*result),
+                 last->command_reason.c_str());
+    return kRefused;
+  }
+  if (!finished(*last)) throw std::runtime_error("the command did not finish within the time-out");
   print(*last);
-  if (refused(*last)) throw std::runtime_error("sg-grasp: " + last->message);
   if (command == Cmd::COMMAND_GRASP && wait)
     return last->outcome == Status::OUTCOME_SUCCESS ? 0 : 3;
   return 0;
@@ -105,6 +112,9 @@ int main(int argc, char** argv) {
   app.add_flag("--wait", wait,
                "wait until the command has run its course (grasp: exit 0 on "
                "success, 3 on failure)");
+  app.footer(
+      "Exit status: 0 done, 3 the grasp failed (--wait), 4 sg-grasp refused the command "
+      "(its reason on stderr), 1 any other error.");
   app.require_subcommand(1);
   auto* track = app.add_subcommand("track", "follow the predicted ball at a stand-off above it");
   track->add_option("--standoff", standoff, "m above the ball (default: sg-grasp's, 0.10)")

@@ -10,10 +10,9 @@
 
 #include <chrono>
 #include <cmath>
-#include <map>
 
 #include "grasp/grasp_machine.hpp"
-#include "grasp/grasp_messages.hpp"
+#include "grasp/grasp_node.hpp"
 #include "common/bus.hpp"
 #include "common/clock.hpp"
 #include "common/program.hpp"
@@ -26,8 +25,6 @@
 #include "stereograsp/trajectory_t.hpp"
 
 namespace {
-
-using sg::grasp::GraspMachine;
 
 struct Options {
   bool no_prediction = false;
@@ -60,76 +57,33 @@ sg::grasp::GraspSettings load_settings(const sg::Config& c, const Options& o) {
   return s;
 }
 
-/// The fields a person watches: a change of any is published and logged at once.
-std::string summary(const sg::grasp::GraspStatusView& v) {
-  return std::string(to_string(v.state)) + ", " + to_string(v.activity) + ", last " +
-         to_string(v.last_action) + ", outcome " + to_string(v.outcome) +
-         (v.message.empty() ? "" : ": " + v.message);
-}
-
 int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
         const sg::grasp::GraspSettings& settings, double status_rate) {
   sg::install_shutdown_handlers();
   sg::Bus bus(url);
-  GraspMachine machine(geometry, settings, sg::now_utime());
-  std::map<std::string, int64_t> last_command;  // per sender
-  int64_t trajectory_utime = 0;                 // the newest OBJECT_TRAJECTORY's
+  sg::grasp::GraspNode node(geometry, settings, sg::now_utime(), 1.0 / status_rate);
   bus.subscribe<stereograsp::trajectory_t>("OBJECT_TRAJECTORY", [&](const auto& m, const auto&) {
-    trajectory_utime = m.utime;
-    std::string why;
-    if (auto path = sg::grasp::path_from(m, &why)) {
-      machine.on_trajectory(*path, m.source_utime, sg::now_utime());
-    } else {
-      spdlog::warn("OBJECT_TRAJECTORY at {}: {}; ignored", m.utime, why);
-    }
+    const std::string why = node.on_trajectory(m, sg::now_utime());
+    if (!why.empty()) spdlog::warn("OBJECT_TRAJECTORY at {}: {}; ignored", m.utime, why);
   });
-  bus.subscribe<stereograsp::point3_t>("OBJECT_POSITION", [&](const auto& m, const auto&) {
-    const Eigen::Vector3d p(m.position[0], m.position[1], m.position[2]);
-    machine.on_measurement(m.visible && p.allFinite() ? std::optional(p) : std::nullopt, m.utime);
-  });
-  bus.subscribe<stereograsp::arm_status_t>("ARM_STATUS", [&](const auto& m, const auto&) {
-    machine.on_arm_status(sg::grasp::arm_view_of(m), sg::now_utime());
-  });
+  bus.subscribe<stereograsp::point3_t>("OBJECT_POSITION",
+                                       [&](const auto& m, const auto&) { node.on_position(m); });
+  bus.subscribe<stereograsp::arm_status_t>(
+      "ARM_STATUS", [&](const auto& m, const auto&) { node.on_arm_status(m, sg::now_utime()); });
   bus.subscribe<stereograsp::grasp_command_t>("GRASP_COMMAND", [&](const auto& m, const auto&) {
-    auto [it, fresh] = last_command.try_emplace(m.sender, m.sequence);
-    if (!fresh && m.sequence <= it->second) {
-      spdlog::warn("GRASP_COMMAND {} from '{}': sequence not newer than {}; ignored", m.sequence,
-                   m.sender, it->second);
-      return;
+    const sg::grasp::CommandRecord& r = node.on_command(m, sg::now_utime());
+    if (r.reply.result != sg::grasp::CommandResult::kAccepted) {
+      spdlog::warn("GRASP_COMMAND {} from '{}': {}: {}", m.sequence, m.sender,
+                   to_string(r.reply.result), r.reply.reason);
     }
-    it->second = m.sequence;
-    if (m.command < 1 || m.command > 5) {
-      spdlog::warn("GRASP_COMMAND {} from '{}': unknown command {}", m.sequence, m.sender,
-                   static_cast<int>(m.command));
-      return;
-    }
-    if (!std::isfinite(m.standoff) || m.standoff < 0 || m.standoff > 0.5) {
-      spdlog::warn("GRASP_COMMAND {}: stand-off {} m outside 0..0.5; ignored", m.sequence,
-                   m.standoff);
-      return;
-    }
-    machine.on_command(static_cast<sg::grasp::GraspCommand>(m.command), m.standoff, sg::now_utime());
   });
   spdlog::info("grasping {} prediction", settings.use_prediction ? "with" : "WITHOUT");
-  const auto period = std::chrono::duration<double>(1.0 / status_rate);
-  auto next = std::chrono::steady_clock::now();
-  std::string last_summary;
   while (!sg::shutdown_requested()) {
     bus.handle(std::chrono::milliseconds(10));
-    const int64_t now = sg::now_utime();
-    if (auto request = machine.take_request(now)) {
-      // utime: the message time of the decision, the newest trajectory's (the clock's before one).
-      bus.publish("ARM_COMMAND",
-                  sg::grasp::to_arm_cmd(*request, trajectory_utime ? trajectory_utime : now));
-    }
-    const std::string s = summary(machine.status());
-    const auto t = std::chrono::steady_clock::now();
-    if (s != last_summary || t >= next) {
-      bus.publish("GRASP_STATUS", sg::grasp::to_grasp_status(machine.status(), now));
-      if (s != last_summary) spdlog::info("{}", s);
-      last_summary = s;
-      next = t + std::chrono::duration_cast<std::chrono::steady_clock::duration>(period);
-    }
+    const sg::grasp::GraspNode::Output out = node.poll(sg::now_utime());
+    if (out.arm_command) bus.publish("ARM_COMMAND", *out.arm_command);
+    if (out.status) bus.publish("GRASP_STATUS", *out.status);
+    if (!out.changed_summary.empty()) spdlog::info("{}", out.changed_summary);
   }
   return 0;
 }

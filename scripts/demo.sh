@@ -151,18 +151,17 @@ echo "   sg-grasp-ctl track: the arm follows the ball at a stand-off for $track_
 sleep "$track_seconds"
 echo "   sg-grasp-ctl grasp --wait: approach (q1), grasp (q2), hand closed (q3), lifted (q4)"
 # A grasp is refused while the track is not fresh (vision lagging on a loaded machine): ask again.
+# sg-grasp-ctl exits 4 when sg-grasp refuses (GRASP_STATUS.command_result), 3 when the grasp fails.
 outcome=1
 for _ in 1 2 3; do
   set +e
-  "$bin/sg-grasp-ctl" grasp --wait --timeout 60 "${url_args[@]}" 2>&1 \
-    | tee "$session.grasp-ctl.txt" | sed 's/^/   /'
+  "$bin/sg-grasp-ctl" grasp --wait --timeout 60 "${url_args[@]}" 2>&1 | sed 's/^/   /'
   outcome=${PIPESTATUS[0]}
   set -e
-  grep -q "grasp refused" "$session.grasp-ctl.txt" || break
+  [ "$outcome" -eq 4 ] || break
   echo "   (refused; asking again in 2 s)"
   sleep 2
 done
-rm -f "$session.grasp-ctl.txt"
 sleep 2
 kill -INT "$viewer_pid" 2>/dev/null || true
 wait "$viewer_pid" || true

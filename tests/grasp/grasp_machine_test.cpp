@@ -1,8 +1,10 @@
 // The grasp state machine (figure 4): its transition table for every state and command, a full
 // grasp q0 -> q4 judged a success and a failure, abort from every state, a lost track during the
 // approach, no command from a stale or lost trajectory, workspace and table refusals, one request
-// in flight, the delay learning and the --no-prediction mode. Fresh trajectories are a synthetic
-// circle (centre (0.45, 0, 0.10) m, radius 0.15 m, 1 rpm as in the paper) sampled at 4 Hz.
+// in flight, the delay learning and the --no-prediction mode; each command's reply, and the
+// precedence of the one-off requests (STOP over a0 over home, lift and back-off). Fresh
+// trajectories are a synthetic circle (centre (0.45, 0, 0.10) m, radius 0.15 m, 1 rpm as in the
+// paper) sampled at 4 Hz.
 
 #include "grasp/grasp_machine.hpp"
 
@@ -20,12 +22,12 @@
 namespace sg::grasp {
 namespace {
 
+using arm::forward_kinematics;
 using arm::IkResult;
+using arm::motion_time;
 using arm::pose_from_xyz_rpy;
 using arm::rpy_from_rotation;
 using arm::solve_nearest;
-using arm::forward_kinematics;
-using arm::motion_time;
 
 using Cmd = stereograsp::arm_cmd_t;
 
@@ -807,6 +809,147 @@ TEST(GraspMachineTest, NoPredictionAimsAtTheLastMeasurement) {
   EXPECT_FALSE(stale.take().has_value());
 }
 
+// Each command's reply: accepted, or refused by the state (the table's "refused" and "ignored")
+// or by a bad stand-off, with the reason that status().message shows.
+TEST(GraspMachineTest, CommandRepliesSayAcceptedOrWhyRefused) {
+  struct Row {
+    At at;
+    GraspCommand command;
+    double standoff;
+    CommandResult result;
+  };
+  const std::vector<Row> rows = {
+      {At::kQ0Idle, GraspCommand::kTrack, 0, CommandResult::kAccepted},
+      {At::kQ0Idle, GraspCommand::kTrack, -0.1, CommandResult::kRefusedBadArgument},
+      {At::kQ0Idle, GraspCommand::kGrasp, 0, CommandResult::kAccepted},
+      {At::kQ0Idle, GraspCommand::kRelease, 0, CommandResult::kRefusedState},
+      {At::kQ0Homing, GraspCommand::kHome, 0, CommandResult::kAccepted},
+      {At::kQ0BackingOff, GraspCommand::kTrack, 0, CommandResult::kRefusedState},
+      {At::kQ1, GraspCommand::kHome, 0, CommandResult::kRefusedState},
+      {At::kQ2, GraspCommand::kGrasp, 0, CommandResult::kRefusedState},
+      {At::kQ2, GraspCommand::kAbort, 0, CommandResult::kAccepted},
+      {At::kQ4Idle, GraspCommand::kTrack, 0, CommandResult::kRefusedState},
+      {At::kQ4Idle, GraspCommand::kRelease, 0, CommandResult::kAccepted},
+  };
+  for (const Row& row : rows) {
+    SCOPED_TRACE(std::string(name(row.at)) + " + " + to_string(row.command));
+    Rig rig;
+    reach(rig, row.at);
+    rig.advance(0.1);
+    rig.feed();
+    const CommandReply reply = rig.machine.on_command(row.command, row.standoff, rig.now);
+    EXPECT_EQ(reply.result, row.result) << to_string(reply.result) << ": " << reply.reason;
+    if (row.result == CommandResult::kAccepted) {
+      EXPECT_EQ(reply.reason, "");
+    } else {
+      EXPECT_FALSE(reply.reason.empty());
+      EXPECT_EQ(reply.reason, rig.status().message);
+    }
+  }
+  Rig stale;  // a grasp without a fresh track
+  reach(stale, At::kQ0Idle);
+  stale.advance(2.0);
+  const CommandReply reply = stale.machine.on_command(GraspCommand::kGrasp, 0, stale.now);
+  EXPECT_EQ(reply.result, CommandResult::kRefusedState);
+  EXPECT_EQ(reply.reason, "grasp refused: no fresh track of the object");
+  EXPECT_EQ(stale.machine.on_command(static_cast<GraspCommand>(9), 0, stale.now).result,
+            CommandResult::kRefusedUnknownCommand);
+}
+
+// Abort, then home, before the STOP goes out (the arm not connected): the STOP has precedence,
+// the HOME follows it once the STOP is executed.
+TEST(GraspMachineTest, StopGoesBeforeAHomeAskedForAfterIt) {
+  Rig rig;
+  reach(rig, At::kQ0Tracking);
+  rig.arm.connected = false;
+  rig.machine.on_arm_status(rig.arm, rig.now);
+  rig.command(GraspCommand::kAbort);
+  rig.command(GraspCommand::kHome);
+  EXPECT_EQ(rig.machine.next_action(), NextAction::kStop);
+  EXPECT_EQ(rig.status().activity, GraspActivity::kHoming);
+  EXPECT_FALSE(rig.take().has_value());  // not connected
+  rig.arm.connected = true;
+  rig.machine.on_arm_status(rig.arm, rig.now);
+  const std::optional<ArmRequest> stop = rig.take();
+  EXPECT_EQ(kind(stop), Req::kStop);
+  EXPECT_EQ(rig.machine.next_action(), NextAction::kHome);
+  EXPECT_FALSE(rig.take().has_value());  // the STOP in flight
+  rig.executed(*stop);
+  EXPECT_EQ(kind(rig.take()), Req::kHome);
+  EXPECT_EQ(rig.machine.next_action(), NextAction::kNone);
+}
+
+// Release, then home: a0 first, then HOME; and when the arm rejects the a0, a0 is sent again
+// before the HOME (a0 hides the HOME, which the activity takes up again).
+TEST(GraspMachineTest, OpenGoesBeforeAHomeAndIsRetriedFirst) {
+  Rig rig;
+  reach(rig, At::kQ4Idle);
+  rig.command(GraspCommand::kRelease);
+  const std::optional<ArmRequest> open = rig.take();
+  ASSERT_EQ(kind(open), Req::kOpen);
+  EXPECT_EQ(rig.status().state, GraspState::kHandOpened);
+  rig.command(GraspCommand::kHome);
+  EXPECT_EQ(rig.machine.next_action(), NextAction::kHome);
+  rig.rejected(*open);
+  EXPECT_EQ(rig.machine.next_action(), NextAction::kOpen);
+  const std::optional<ArmRequest> again = rig.take();
+  ASSERT_EQ(kind(again), Req::kOpen);
+  EXPECT_EQ(rig.machine.next_action(), NextAction::kHome);
+  rig.executed(*again);
+  EXPECT_EQ(kind(rig.take()), Req::kHome);
+  EXPECT_EQ(rig.status().activity, GraspActivity::kHoming);
+}
+
+// A grasp asked for before the first a0 went out: a0 first, the state stays q1, and the approach
+// follows (a0 in q1 does not undo the grasp).
+TEST(GraspMachineTest, GraspBeforeTheFirstOpenApproachesAfterIt) {
+  Rig rig;
+  rig.feed();
+  EXPECT_EQ(rig.machine.next_action(), NextAction::kOpen);
+  rig.command(GraspCommand::kGrasp);
+  EXPECT_EQ(rig.status().state, GraspState::kApproaching);
+  const std::optional<ArmRequest> open = rig.take();
+  ASSERT_EQ(kind(open), Req::kOpen);
+  EXPECT_EQ(rig.status().state, GraspState::kApproaching);
+  EXPECT_EQ(rig.status().activity, GraspActivity::kGrasping);
+  rig.executed(*open);
+  EXPECT_EQ(kind(rig.take()), Req::kApproach) << rig.status().message;
+  EXPECT_EQ(rig.status().state, GraspState::kGrasping);
+}
+
+// A back-off that the lost track calls for while a0 is pending goes out after the a0.
+TEST(GraspMachineTest, OpenGoesBeforeABackoff) {
+  Rig rig;
+  rig.feed();
+  rig.command(GraspCommand::kGrasp);
+  rig.lose();
+  EXPECT_EQ(rig.status().activity, GraspActivity::kBackingOff);
+  EXPECT_EQ(rig.machine.next_action(), NextAction::kOpen);
+  const std::optional<ArmRequest> open = rig.take();
+  ASSERT_EQ(kind(open), Req::kOpen);
+  EXPECT_EQ(rig.machine.next_action(), NextAction::kBackoff);
+  rig.executed(*open);
+  const std::optional<ArmRequest> up = rig.take();
+  ASSERT_EQ(kind(up), Req::kMove) << rig.status().message;
+  Eigen::Vector3d expected = rig.arm.tool + Eigen::Vector3d(0, 0, 0.10);
+  expected.z() = std::min(expected.z(), rig.geometry.workspace.max.z());
+  EXPECT_LT((up->position - expected).norm(), 1e-12);
+}
+
+// Abort hides every other pending request: after the STOP, no lift, a0 or back-off follows.
+TEST(GraspMachineTest, AbortHidesTheLift) {
+  Rig rig;
+  reach(rig, At::kQ3Grasping);
+  EXPECT_EQ(rig.machine.next_action(), NextAction::kLift);
+  rig.command(GraspCommand::kAbort);
+  EXPECT_EQ(rig.machine.next_action(), NextAction::kStop);
+  const std::optional<ArmRequest> stop = rig.take();
+  ASSERT_EQ(kind(stop), Req::kStop);
+  EXPECT_EQ(rig.machine.next_action(), NextAction::kNone);
+  rig.executed(*stop);
+  EXPECT_FALSE(rig.take().has_value());
+}
+
 // The names shown on GRASP_STATUS and in logs.
 TEST(GraspMachineTest, Names) {
   EXPECT_STREQ(to_string(GraspState::kHandOpened), "q0 hand opened");
@@ -817,6 +960,9 @@ TEST(GraspMachineTest, Names) {
   EXPECT_STREQ(to_string(GraspAction::kNone), "none");
   EXPECT_STREQ(to_string(GraspOutcome::kSuccess), "success");
   EXPECT_STREQ(to_string(GraspCommand::kAbort), "abort");
+  EXPECT_STREQ(to_string(CommandResult::kAccepted), "accepted");
+  EXPECT_STREQ(to_string(CommandResult::kRefusedState), "refused: state");
+  EXPECT_STREQ(to_string(static_cast<CommandResult>(42)), "unknown");
 }
 
 }  // namespace

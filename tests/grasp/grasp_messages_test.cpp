@@ -1,5 +1,5 @@
-// The grasp machine's values as LCM messages: every field carried across, malformed trajectories
-// refused with the reason.
+// The grasp machine's values as LCM messages: every field carried across (the command's answer
+// too), malformed trajectories refused with the reason.
 
 #include "grasp/grasp_messages.hpp"
 
@@ -10,12 +10,12 @@
 namespace sg::grasp {
 namespace {
 
+using arm::forward_kinematics;
 using arm::IkResult;
+using arm::motion_time;
 using arm::pose_from_xyz_rpy;
 using arm::rpy_from_rotation;
 using arm::solve_nearest;
-using arm::forward_kinematics;
-using arm::motion_time;
 
 using stereograsp::arm_cmd_t;
 using stereograsp::arm_status_t;
@@ -97,8 +97,28 @@ TEST(GraspMessages, StatusToGraspStatus) {
   EXPECT_EQ(m.outcome, stereograsp::grasp_status_t::OUTCOME_FAILED);
   EXPECT_EQ(m.message, "why");
   EXPECT_TRUE(std::isnan(m.target[0]));
+  EXPECT_EQ(m.command_sequence, -1);  // no command yet
+  EXPECT_EQ(m.command_result, stereograsp::grasp_status_t::RESULT_NONE);
   v.target = Eigen::Vector3d(0.1, 0.2, 0.3);
   EXPECT_EQ(to_grasp_status(v, 11).target[2], 0.3);
+  const CommandRecord refused{12, {CommandResult::kRefusedState, "grasp refused: no track"}};
+  m = to_grasp_status(v, 11, refused);
+  EXPECT_EQ(m.command_sequence, 12);
+  EXPECT_EQ(m.command_result, stereograsp::grasp_status_t::RESULT_REFUSED_STATE);
+  EXPECT_EQ(m.command_reason, "grasp refused: no track");
+}
+
+// The machine's command results are grasp_status_t's RESULT_* values.
+TEST(GraspMessages, CommandResultsAreTheMessagesConstants) {
+  using S = stereograsp::grasp_status_t;
+  EXPECT_EQ(static_cast<int8_t>(CommandResult::kNone), S::RESULT_NONE);
+  EXPECT_EQ(static_cast<int8_t>(CommandResult::kAccepted), S::RESULT_ACCEPTED);
+  EXPECT_EQ(static_cast<int8_t>(CommandResult::kRefusedNotNewer), S::RESULT_REFUSED_NOT_NEWER);
+  EXPECT_EQ(static_cast<int8_t>(CommandResult::kRefusedUnknownCommand),
+            S::RESULT_REFUSED_UNKNOWN_COMMAND);
+  EXPECT_EQ(static_cast<int8_t>(CommandResult::kRefusedBadArgument),
+            S::RESULT_REFUSED_BAD_ARGUMENT);
+  EXPECT_EQ(static_cast<int8_t>(CommandResult::kRefusedState), S::RESULT_REFUSED_STATE);
 }
 
 // A well-formed trajectory becomes a path with its times and points.

@@ -1,0 +1,114 @@
+#include "grasp/grasp_node.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace sg::grasp {
+namespace {
+
+/// `text` as printable ASCII (anything else '?'), at most `limit` characters.
+std::string ascii(const std::string& text, std::size_t limit) {
+  std::string out = text.substr(0, limit);
+  for (char& c : out) {
+    if (c < 0x20 || c > 0x7e) c = '?';
+  }
+  return out;
+}
+
+}  // namespace
+
+GraspNode::GraspNode(ArmGeometry geometry, GraspSettings settings, int64_t first_sequence,
+                     double status_period)
+    : machine_(std::move(geometry), std::move(settings), first_sequence),
+      status_period_us_(std::llround(status_period * 1e6)) {}
+
+std::string GraspNode::on_trajectory(const stereograsp::trajectory_t& trajectory, int64_t now) {
+  trajectory_utime_ = trajectory.utime;
+  std::string why;
+  std::optional<PredictedPath> path = path_from(trajectory, &why);
+  if (!path) return why;
+  machine_.on_trajectory(*path, trajectory.source_utime, now);
+  return "";
+}
+
+void GraspNode::on_position(const stereograsp::point3_t& m) {
+  const Eigen::Vector3d p(m.position[0], m.position[1], m.position[2]);
+  machine_.on_measurement(m.visible && p.allFinite() ? std::optional(p) : std::nullopt, m.utime);
+}
+
+void GraspNode::on_arm_status(const stereograsp::arm_status_t& status, int64_t now) {
+  machine_.on_arm_status(arm_view_of(status), now);
+}
+
+const CommandRecord& GraspNode::on_command(const stereograsp::grasp_command_t& m, int64_t now) {
+  std::string why;
+  if (!newer(m, now, &why)) return answer(m.sequence, CommandResult::kRefusedNotNewer, why);
+  if (m.command < stereograsp::grasp_command_t::COMMAND_TRACK ||
+      m.command > stereograsp::grasp_command_t::COMMAND_HOME) {
+    return answer(m.sequence, CommandResult::kRefusedUnknownCommand,
+                  "unknown command " + std::to_string(static_cast<int>(m.command)));
+  }
+  if (!(std::isfinite(m.standoff) && m.standoff >= 0 && m.standoff <= kMaxStandoff)) {
+    return answer(m.sequence, CommandResult::kRefusedBadArgument,
+                  "stand-off " + std::to_string(m.standoff) + " m outside 0..0.5 m");
+  }
+  CommandReply reply = machine_.on_command(static_cast<GraspCommand>(m.command), m.standoff, now);
+  return answer(m.sequence, reply.result, std::move(reply.reason));
+}
+
+bool GraspNode::newer(const stereograsp::grasp_command_t& m, int64_t now, std::string* why) {
+  const auto it = senders_.find(m.sender);
+  if (it != senders_.end()) {
+    it->second.heard_utime = now;
+    if (m.sequence <= it->second.sequence) {
+      *why = "sequence " + std::to_string(m.sequence) + " from '" + m.sender + "' not newer than " +
+             std::to_string(it->second.sequence);
+      return false;
+    }
+    it->second.sequence = m.sequence;
+    return true;
+  }
+  if (senders_.size() >= kMaxSenders) {  // forget the longest silent
+    senders_.erase(std::min_element(senders_.begin(), senders_.end(), [](auto& a, auto& b) {
+      return a.second.heard_utime < b.second.heard_utime;
+    }));
+  }
+  senders_.emplace(m.sender, Sender{m.sequence, now});
+  return true;
+}
+
+const CommandRecord& GraspNode::answer(int64_t sequence, CommandResult result, std::string reason) {
+  command_.sequence = sequence;
+  command_.reply.result = result;
+  command_.reply.reason = ascii(reason, kMaxReason);
+  command_changed_ = true;
+  return command_;
+}
+
+GraspNode::Output GraspNode::poll(int64_t now) {
+  Output out;
+  if (std::optional<ArmRequest> request = machine_.take_request(now)) {
+    out.arm_command = to_arm_cmd(*request, trajectory_utime_ ? trajectory_utime_ : now);
+  }
+  const std::string s = summary(machine_.status());
+  const bool changed = s != last_summary_;
+  const bool due = !last_status_utime_ || now >= *last_status_utime_ + status_period_us_ ||
+                   now < *last_status_utime_;
+  if (changed || command_changed_ || due) {
+    out.status = to_grasp_status(machine_.status(), now, command_);
+    if (changed) out.changed_summary = s;
+    last_summary_ = s;
+    command_changed_ = false;
+    last_status_utime_ = now;
+  }
+  return out;
+}
+
+std::string GraspNode::summary(const GraspStatusView& v) {
+  return std::string(to_string(v.state)) + ", " + to_string(v.activity) + ", last " +
+         to_string(v.last_action) + ", outcome " + to_string(v.outcome) +
+         (v.message.empty() ? "" : ": " + v.message);
+}
+
+}  // namespace sg::grasp

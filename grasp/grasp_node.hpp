@@ -1,0 +1,110 @@
+#pragma once
+
+/// sg-grasp without the bus: what the process does between the decoded messages and the grasp
+/// machine. It takes OBJECT_TRAJECTORY, OBJECT_POSITION, ARM_STATUS and GRASP_COMMAND with their
+/// receive time, and poll(now) says what to publish now. All time comes in as arguments (us since
+/// the Unix epoch); the node never reads a clock, so an in-process trial on a simulated clock
+/// (system/grasp_trial.cpp) drives the same logic as sg-grasp.
+///
+///   - GRASP_COMMAND: refused when its `sequence` is not newer than its sender's last (a replay),
+///     when `command` is not a COMMAND_* value, or when `standoff` is not finite in 0..0.5 m;
+///     otherwise the machine answers (accepted, or refused by its state). Every command's answer
+///     goes out on the next GRASP_STATUS (command_sequence, command_result, command_reason).
+///     The last sequence of at most kMaxSenders senders is kept (the longest silent is forgotten
+///     first), so no stream of made-up senders exhausts the process.
+///   - ARM_COMMAND: at most one per poll(), the machine's take_request(now); its utime is the
+///     newest trajectory's utime (the decision's message time), `now` before any trajectory.
+///   - GRASP_STATUS: when the summary (state, activity, last action, outcome, message) or the
+///     command answer changed, and otherwise once per status period (also when `now` went back
+///     in time, so a clock step cannot silence it).
+///
+///     GraspNode node(geometry, settings, /*first_sequence=*/now, /*status_period=*/0.25);
+///     node.on_command(command, now);                    // from each subscription
+///     GraspNode::Output out = node.poll(now);           // from the loop, every 10 ms
+///     if (out.arm_command) bus.publish("ARM_COMMAND", *out.arm_command);
+///     if (out.status) bus.publish("GRASP_STATUS", *out.status);
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+
+#include "grasp/grasp_machine.hpp"
+#include "grasp/grasp_messages.hpp"
+#include "stereograsp/arm_cmd_t.hpp"
+#include "stereograsp/arm_status_t.hpp"
+#include "stereograsp/grasp_command_t.hpp"
+#include "stereograsp/grasp_status_t.hpp"
+#include "stereograsp/point3_t.hpp"
+#include "stereograsp/trajectory_t.hpp"
+
+namespace sg::grasp {
+
+class GraspNode {
+ public:
+  /// Senders whose last sequence is remembered.
+  static constexpr std::size_t kMaxSenders = 64;
+  /// Characters of a command_reason (longer ones are cut).
+  static constexpr std::size_t kMaxReason = 200;
+  /// The largest stand-off a GRASP_COMMAND may ask for, m.
+  static constexpr double kMaxStandoff = 0.5;
+
+  /// What to publish now.
+  struct Output {
+    std::optional<stereograsp::arm_cmd_t> arm_command;  ///< ARM_COMMAND
+    std::optional<stereograsp::grasp_status_t> status;  ///< GRASP_STATUS
+    std::string changed_summary;  ///< the new summary when it changed (for the log), else ""
+  };
+
+  /// `first_sequence`: the first ARM_COMMAND's sequence; `status_period`: s between
+  /// GRASP_STATUS messages when nothing changes (> 0).
+  GraspNode(ArmGeometry geometry, GraspSettings settings, int64_t first_sequence,
+            double status_period);
+
+  /// An OBJECT_TRAJECTORY received at `now`. Returns "" when the machine took it, else why it
+  /// was ignored (a malformed one; path_from()).
+  std::string on_trajectory(const stereograsp::trajectory_t& trajectory, int64_t now);
+
+  /// An OBJECT_POSITION: the measurement at its utime (not visible or not finite: none).
+  void on_position(const stereograsp::point3_t& position);
+
+  /// An ARM_STATUS received at `now`.
+  void on_arm_status(const stereograsp::arm_status_t& status, int64_t now);
+
+  /// A GRASP_COMMAND received at `now`: the sequence and range checks, then the machine.
+  /// Returns the answer that the next GRASP_STATUS carries.
+  const CommandRecord& on_command(const stereograsp::grasp_command_t& command, int64_t now);
+
+  /// What to publish at `now`: at most one ARM_COMMAND, and GRASP_STATUS on a change or when
+  /// the status period has passed.
+  Output poll(int64_t now);
+
+  const GraspMachine& machine() const { return machine_; }
+  /// The answer to the last command (sequence -1 before any).
+  const CommandRecord& last_command() const { return command_; }
+
+  /// "q3 hand closed, grasping, last a2 close hand, outcome none: <message>".
+  static std::string summary(const GraspStatusView& view);
+
+ private:
+  struct Sender {
+    int64_t sequence = 0;
+    int64_t heard_utime = 0;
+  };
+
+  /// Records the answer to command `sequence` (its reason made short ASCII).
+  const CommandRecord& answer(int64_t sequence, CommandResult result, std::string reason);
+  /// Checks `command`'s sequence against its sender's last; true when newer (or first).
+  bool newer(const stereograsp::grasp_command_t& command, int64_t now, std::string* why);
+
+  GraspMachine machine_;
+  int64_t status_period_us_;
+  int64_t trajectory_utime_ = 0;  ///< the newest OBJECT_TRAJECTORY's utime (0: none yet)
+  std::map<std::string, Sender> senders_;
+  CommandRecord command_;
+  bool command_changed_ = false;
+  std::string last_summary_;
+  std::optional<int64_t> last_status_utime_;  ///< when GRASP_STATUS last went out
+};
+
+}  // namespace sg::grasp
