@@ -9,7 +9,6 @@
 ///     if (rule.due(version, clock.now())) bus.publish("ARM_STATUS", status);
 
 #include <cstdint>
-#include <optional>
 
 namespace sg {
 
@@ -21,8 +20,10 @@ class ChangeOrPeriod {
   /// True when `version` differs from the last published one, the period has passed since the
   /// last publication, or time went back; then `now` (seconds) counts as published.
   bool due(uint64_t version, double now) {
-    const bool due = !last_ || version != version_ || now >= *last_ + period_ || now < *last_;
+    const bool due =
+        !published_ || version != version_ || now >= last_ + period_ || now < last_;
     if (due) {
+      published_ = true;
       version_ = version;
       last_ = now;
     }
@@ -31,8 +32,9 @@ class ChangeOrPeriod {
 
  private:
   double period_;
+  bool published_ = false;
   uint64_t version_ = 0;
-  std::optional<double> last_;
+  double last_ = 0;
 };
 
 }  // namespace sg
