@@ -21,7 +21,7 @@ std::string ascii(const std::string& text, std::size_t limit) {
 GraspNode::GraspNode(ArmGeometry geometry, GraspSettings settings, int64_t first_sequence,
                      double status_period)
     : machine_(std::move(geometry), std::move(settings), first_sequence),
-      status_period_us_(std::llround(status_period * 1e6)) {}
+      status_rule_(status_period) {}
 
 std::string GraspNode::on_trajectory(const stereograsp::trajectory_t& trajectory, int64_t now) {
   trajectory_utime_ = trajectory.utime;
@@ -93,14 +93,12 @@ GraspNode::Output GraspNode::poll(int64_t now) {
   }
   const std::string s = summary(machine_.status());
   const bool changed = s != last_summary_;
-  const bool due = !last_status_utime_ || now >= *last_status_utime_ + status_period_us_ ||
-                   now < *last_status_utime_;
-  if (changed || command_changed_ || due) {
+  if (changed || command_changed_) ++status_version_;
+  if (status_rule_.due(status_version_, static_cast<double>(now) * 1e-6)) {
     out.status = to_grasp_status(machine_.status(), now, command_);
     if (changed) out.changed_summary = s;
     last_summary_ = s;
     command_changed_ = false;
-    last_status_utime_ = now;
   }
   return out;
 }

@@ -29,6 +29,7 @@
 #include <optional>
 #include <string>
 
+#include "common/change_or_period.hpp"
 #include "grasp/grasp_machine.hpp"
 #include "grasp/grasp_messages.hpp"
 #include "stereograsp/arm_cmd_t.hpp"
@@ -98,13 +99,13 @@ class GraspNode {
   bool newer(const stereograsp::grasp_command_t& command, int64_t now, std::string* why);
 
   GraspMachine machine_;
-  int64_t status_period_us_;
+  ChangeOrPeriod status_rule_;  ///< GRASP_STATUS on a change, else once a period
+  uint64_t status_version_ = 0;  ///< counts the changes of the summary and the command answer
   int64_t trajectory_utime_ = 0;  ///< the newest OBJECT_TRAJECTORY's utime (0: none yet)
   std::map<std::string, Sender> senders_;
   CommandRecord command_;
   bool command_changed_ = false;
   std::string last_summary_;
-  std::optional<int64_t> last_status_utime_;  ///< when GRASP_STATUS last went out
 };
 
 }  // namespace sg::grasp
