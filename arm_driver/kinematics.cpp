@@ -327,6 +327,17 @@ Eigen::Vector3d read_vector3(const sg::Config& config, const std::string& key,
 
 ArmGeometry load_arm_geometry(const sg::Config& config) {
   ArmGeometry g = ArmGeometry::a465();
+  const auto text = [](const Eigen::Vector3d& v) { return sg::show({v.x(), v.y(), v.z()}); };
+  sg::Section arm(config, "arm");
+  arm.known("dh", "the A465's", "modified DH rows [alpha_deg, a_m, d_m, theta_offset_deg]");
+  arm.known("limits_deg", "the A465's", "joint limits [[min_deg, max_deg] x 6]");
+  std::vector<double> speeds_deg;
+  for (const DhLink& l : g.links) speeds_deg.push_back(l.max_speed / kRadPerDeg);
+  arm.known("max_speed_deg_s", sg::show(speeds_deg), "joint speed limits, deg/s", 6);
+  arm.known("tool_offset", text(g.tool.translation()), "TCP in the flange frame, m", 3);
+  arm.known("workspace_min", text(g.workspace.min), "the workspace's lower corner, m", 3);
+  arm.known("workspace_max", text(g.workspace.max), "the workspace's upper corner, m", 3);
+  arm.done();
   if (config.has("arm.dh")) {
     const auto rows = read_rows(config, "arm.dh", 6, 4, "[alpha_deg, a_m, d_m, theta_offset_deg]");
     for (int i = 0; i < 6; ++i) {

@@ -8,6 +8,15 @@
 #include "common/message_types.hpp"
 
 namespace sg::bus_check {
+
+SendSettings read_send_settings(const Config& config) {
+  SendSettings s;
+  Section c(config, "bus_check");
+  c.number("count", s.count, Range::at_least(0), "messages to send, 0 for no limit");
+  c.number("rate_hz", s.rate_hz, Range::above(0), "messages per second");
+  c.done();
+  return s;
+}
 namespace {
 
 using namespace stereograsp;
@@ -142,6 +151,9 @@ void fill(grasp_status_t& m, Pattern& p) {
   m.target_utime = p.integer();
   m.outcome = p.small();
   m.message = p.text();
+  m.command_sequence = p.integer();
+  m.command_result = p.small();
+  m.command_reason = p.text();
 }
 void fill(sim_arm_state_t& m, Pattern& p) {
   p.fill(m.joints);

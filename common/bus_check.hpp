@@ -5,7 +5,18 @@
 #include <string>
 #include <vector>
 
+#include "common/config.hpp"
+
 namespace sg::bus_check {
+
+/// What `sg-bus-check send` is configured with: the `bus_check` section.
+struct SendSettings {
+  int64_t count = 1000;   ///< messages to send, 0 for no limit
+  double rate_hz = 100;   ///< messages per second
+};
+
+/// Reads the `bus_check` section (range-checked; unknown keys refused).
+SendSettings read_send_settings(const Config& config);
 
 /// Messages for checking a bus end to end. Every field of a check message is derived from its
 /// `utime` by a fixed pseudo-random rule, so a receiver (or a log reader) that knows only the

@@ -185,12 +185,9 @@ int main(int argc, char** argv) {
 
   SendOptions send;
   CLI::App* send_cmd = app.add_subcommand("send", "Publish check messages on BUS_CHECK_<TYPE>");
-  CLI::Option* send_count = send_cmd->add_option("--count", send.count,
-                                                 "messages to send, 0 for no limit (default 1000, "
-                                                 "config bus_check.count)");
-  CLI::Option* send_rate = send_cmd->add_option("--rate", send.rate_hz,
-                                                "messages per second (default 100, config "
-                                                "bus_check.rate_hz)");
+  const auto keys = sg::declared_keys(sg::bus_check::read_send_settings);
+  common.flags.add(*send_cmd, "--count", "bus_check.count", keys);
+  common.flags.add(*send_cmd, "--rate", "bus_check.rate_hz", keys);
   send_cmd->add_option("--duration", send.duration_s, "stop after this many seconds (0: no limit)")
       ->check(CLI::NonNegativeNumber);
 
@@ -213,13 +210,9 @@ int main(int argc, char** argv) {
     const sg::Config config = sg::load_common(common);
     if (*verify_cmd) return run_verify_log(log_path, log_count);
 
-    if (!*send_count) send.count = config.get<int64_t>("bus_check.count", send.count);
-    if (!*send_rate) send.rate_hz = config.get<double>("bus_check.rate_hz", send.rate_hz);
-    if (!std::isfinite(send.rate_hz) || send.rate_hz <= 0) {
-      if (*send_rate) throw std::runtime_error("--rate must be a positive number");
-      throw config.error_at("bus_check.rate_hz", "must be a positive number");
-    }
-    if (send.count < 0) throw config.error_at("bus_check.count", "must not be negative");
+    const sg::bus_check::SendSettings settings = sg::bus_check::read_send_settings(config);
+    send.count = settings.count;
+    send.rate_hz = settings.rate_hz;
 
     sg::install_shutdown_handlers();
     sg::Bus bus(common.lcm_url);

@@ -38,7 +38,7 @@ std::unique_ptr<AxisModel> make_burg_axis(const BurgParams& params);
 /// noise of spectral density `q` (m^2/s^3), measurement noise `r` (m, standard deviation).
 struct KalmanParams {
   double period = 0.25;
-  double q = 1e-4;
+  double q = 1e-5;  ///< tuned on the paper's motion (docs/prediction.md)
   double r = 0.001;
 };
 std::unique_ptr<AxisModel> make_kalman_axis(const KalmanParams& params);

@@ -10,72 +10,22 @@
 //   sg-predictor train positions.csv --out coeffs.yaml   # lines utime,x,y,z (or t_s,x,y,z)
 
 #include <spdlog/spdlog.h>
-#include <yaml-cpp/yaml.h>
 
-#include <cmath>
-#include <fstream>
-#include <lcm/lcm-cpp.hpp>
-#include <sstream>
+#include <cstdio>
 
 #include "common/bus.hpp"
 #include "common/message_types.hpp"
 #include "common/program.hpp"
 #include "common/shutdown.hpp"
-#include "predictor/burg.hpp"
+#include "predictor/offline_training.hpp"
+#include "predictor/predictor_settings.hpp"
 #include "predictor/trajectory_message.hpp"
 #include "predictor/trajectory_predictor.hpp"
 
 namespace {
 
 using sg::predictor::Forecast;
-using sg::predictor::Measurement;
 using sg::predictor::PredictorParams;
-using sg::predictor::TrackStatus;
-
-PredictorParams load_params(const sg::Config& c) {
-  PredictorParams p;
-  p.model = sg::predictor::model_from_name(c.get<std::string>("predictor.model", "burg"));
-  p.period_us = std::llround(c.get<double>("predictor.period", 0.25) * 1e6);
-  p.horizon = c.get<int>("predictor.horizon", p.horizon);
-  p.max_gap = c.get<int>("predictor.max_gap", p.max_gap);
-  p.burg.order = c.get<int>("predictor.order", p.burg.order);
-  p.burg.window = c.get<int>("predictor.window", p.burg.window);
-  p.burg.remove_mean = c.get<bool>("predictor.remove_mean", p.burg.remove_mean);
-  p.burg.online_after = c.get<int>("predictor.online_after", p.burg.online_after);
-  p.gate = c.get<double>("predictor.gate", p.gate);
-  p.gate_patience_us = std::llround(c.get<double>("predictor.gate_patience", 0.5) * 1e6);
-  if (!(p.gate >= 0)) throw c.error_at("predictor.gate", "must be 0 (off) or positive");
-  if (p.gate_patience_us < 0) throw c.error_at("predictor.gate_patience", "must not be negative");
-  p.kalman.q = c.get<double>("predictor.kalman_q", p.kalman.q);
-  p.kalman.r = c.get<double>("predictor.kalman_r", p.kalman.r);
-  if (p.period_us <= 0) throw c.error_at("predictor.period", "must be positive");
-  if (p.horizon < 1) throw c.error_at("predictor.horizon", "must be at least 1");
-  if (p.burg.order < 1) throw c.error_at("predictor.order", "must be at least 1");
-  if (p.burg.window < p.burg.order + 3)
-    throw c.error_at("predictor.window", "must exceed the order by 3");
-  if (p.burg.online_after < 0 || p.burg.online_after > p.burg.window)
-    throw c.error_at("predictor.online_after", "must be 0 to the window's length");
-  return p;
-}
-
-void load_coefficients(const std::string& path, PredictorParams& p) {
-  const sg::Config c = sg::Config::load(path);
-  const int order = c.require<int>("order");
-  if (order != p.burg.order) {
-    spdlog::debug("{}: order {} (the coefficients set the order)", path, order);
-    p.burg.order = order;
-  }
-  const char* axes[3] = {"x", "y", "z"};
-  for (int i = 0; i < 3; ++i) {
-    const std::string key = std::string("coefficients.") + axes[i];
-    auto a = c.require<std::vector<double>>(key);
-    if (static_cast<int>(a.size()) != order) throw c.error_at(key, "must hold `order` numbers");
-    for (double v : a) {
-      if (!std::isfinite(v)) throw c.error_at(key, "holds a non-finite number");
-    }
-    p.initial_coefficients[static_cast<size_t>(i)] = a;
-  }
-}
 
 int run(const std::string& url, const PredictorParams& params) {
   sg::install_shutdown_handlers();
@@ -107,85 +57,30 @@ int run(const std::string& url, const PredictorParams& params) {
   return 0;
 }
 
-/// (utime, position) of the visible measurements in a CSV (utime or seconds, x, y, z) or a log.
-std::vector<Measurement> read_training(const std::string& input, const std::string& channel) {
-  std::vector<Measurement> out;
-  if (input.size() > 4 && input.substr(input.size() - 4) == ".csv") {
-    std::ifstream file(input);
-    if (!file) throw std::runtime_error(input + ": cannot open");
-    std::string line;
-    for (int number = 1; std::getline(file, line); ++number) {
-      if (line.empty() || line[0] == '#' ||
-          !(std::isdigit(static_cast<unsigned char>(line[0])) || line[0] == '-'))
-        continue;
-      std::stringstream s(line);
-      double t, x, y, z;
-      char c1, c2, c3;
-      if (!(s >> t >> c1 >> x >> c2 >> y >> c3 >> z))
-        throw std::runtime_error(input + ":" + std::to_string(number) + ": expected t,x,y,z");
-      const int64_t utime = t > 1e12 ? static_cast<int64_t>(t) : std::llround(t * 1e6);
-      out.push_back({utime, true, {x, y, z}});
-    }
-    return out;
-  }
-  lcm::LogFile log(input, "r");
-  if (!log.good()) throw std::runtime_error(input + ": cannot open as an LCM log (or give a .csv)");
-  while (const lcm::LogEvent* e = log.readNextEvent()) {
-    if (e->channel != channel) continue;
-    stereograsp::point3_t p;
-    if (p.decode(e->data, 0, e->datalen) != e->datalen || !p.visible) continue;
-    out.push_back({p.utime, true, {p.position[0], p.position[1], p.position[2]}});
-  }
-  return out;
-}
-
-int train(const std::string& input, const std::string& channel, PredictorParams params,
+/// Trains Burg coefficients from `input` (a .csv, else an LCM log) and writes them to `out`.
+int train(const std::string& input, const std::string& channel, const PredictorParams& params,
           const std::string& out) {
-  const auto measurements = read_training(input, channel);
+  const bool csv = input.size() > 4 && input.substr(input.size() - 4) == ".csv";
+  const auto measurements = csv ? sg::predictor::read_training_csv(input)
+                                : sg::predictor::read_training_log(input, channel);
   if (measurements.empty()) {
     throw std::runtime_error(input + ": no visible " + channel +
                              " positions (an LCM log with that channel, or a CSV of t,x,y,z)");
   }
-  params.model = sg::predictor::Model::kHold;  // only to resample onto the period
-  sg::predictor::TrajectoryPredictor resampler(params);
-  std::array<std::vector<double>, 3> series;
-  for (const Measurement& m : measurements) {
-    for (const Forecast& f : resampler.add(m)) {
-      if (f.status != TrackStatus::kTracking) continue;
-      for (int i = 0; i < 3; ++i) series[static_cast<size_t>(i)].push_back(f.sample[i]);
-    }
+  sg::predictor::TrainedCoefficients trained;
+  try {
+    trained = sg::predictor::train_coefficients(measurements, params);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(input + ": " + e.what());
   }
-  const int n = static_cast<int>(series[0].size());
-  if (n < 2 * params.burg.order + 3)
-    throw std::runtime_error(input + ": " + std::to_string(n) +
-                             " samples at the period; need at least " +
-                             std::to_string(2 * params.burg.order + 3));
-  YAML::Emitter yaml;
-  yaml << YAML::BeginMap << YAML::Key << "order" << YAML::Value << params.burg.order << YAML::Key
-       << "period" << YAML::Value << params.period_us * 1e-6 << YAML::Key << "samples"
-       << YAML::Value << n << YAML::Key << "source" << YAML::Value << input << YAML::Key
-       << "coefficients" << YAML::Value << YAML::BeginMap;
   const char* axes[3] = {"x", "y", "z"};
-  for (int i = 0; i < 3; ++i) {
-    std::vector<double> x = series[static_cast<size_t>(i)];
-    double mean = 0;
-    for (double v : x) mean += v;
-    mean /= n;
-    for (double& v : x) v -= mean;
-    const auto b = sg::predictor::burg(x.data(), n, params.burg.order);
-    yaml << YAML::Key << axes[i] << YAML::Value << YAML::Flow << YAML::Precision(17)
-         << b.coefficients;
-    std::printf("%s: error power %.3g m^2 of %.3g\n", axes[i], b.error_power.back(),
-                b.error_power.front());
+  for (size_t i = 0; i < 3; ++i) {
+    std::printf("%s: error power %.3g m^2 of %.3g\n", axes[i], trained.error_power[i].back(),
+                trained.error_power[i].front());
   }
-  yaml << YAML::EndMap << YAML::EndMap;
-  std::ofstream file(out + ".tmp");
-  file << "# trained by: sg-predictor train " << input << "\n" << yaml.c_str() << "\n";
-  file.close();
-  if (!file || std::rename((out + ".tmp").c_str(), out.c_str()) != 0)
-    throw std::runtime_error(out + ": cannot write");
-  std::printf("trained order %d on %d samples from %s; wrote %s\n", params.burg.order, n,
-              input.c_str(), out.c_str());
+  sg::predictor::write_coefficients(out, trained, input);
+  std::printf("trained order %d on %d samples from %s; wrote %s\n", trained.order,
+              trained.samples, input.c_str(), out.c_str());
   return 0;
 }
 
@@ -196,15 +91,12 @@ int main(int argc, char** argv) {
                "sg-predictor"};
   sg::CommonOptions common;
   sg::add_common_options(app, common);
-  std::string model, coefficients;
-  int order = 0, window = 0, horizon = 0;
-  app.add_option("--model", model, "burg (default), kalman or hold")
-      ->check(CLI::IsMember({"burg", "kalman", "hold"}));
-  app.add_option("--coefficients", coefficients,
-                 "offline-trained coefficients (sg-predictor train)");
-  app.add_option("--order", order, "Burg order p (default 12)");
-  app.add_option("--window", window, "samples in the sliding window W (default 480)");
-  app.add_option("--horizon", horizon, "samples forecast H (default 16)");
+  const auto keys = sg::declared_keys(sg::predictor::read_predictor_settings);
+  common.flags.add(app, "--model", "predictor.model", keys);
+  common.flags.add(app, "--coefficients", "predictor.coefficients", keys);
+  common.flags.add(app, "--order", "predictor.order", keys);
+  common.flags.add(app, "--window", "predictor.window", keys);
+  common.flags.add(app, "--horizon", "predictor.horizon", keys);
   std::string input, out, channel = "OBJECT_POSITION";
   CLI::App* train_cmd =
       app.add_subcommand("train", "Train Burg coefficients offline from a log or a CSV");
@@ -214,14 +106,10 @@ int main(int argc, char** argv) {
 
   return sg::run_program(app, argc, argv, [&] {
     const sg::Config config = sg::load_common(common);
-    PredictorParams params = load_params(config);
-    if (!model.empty()) params.model = sg::predictor::model_from_name(model);
-    if (order > 0) params.burg.order = order;
-    if (window > 0) params.burg.window = window;
-    if (horizon > 0) params.horizon = horizon;
-    if (*train_cmd) return train(input, channel, params, out);
-    if (coefficients.empty()) coefficients = config.get<std::string>("predictor.coefficients", "");
-    if (!coefficients.empty()) load_coefficients(coefficients, params);
-    return run(common.lcm_url, params);
+    sg::predictor::PredictorSettings settings = sg::predictor::read_predictor_settings(config);
+    if (*train_cmd) return train(input, channel, settings.params, out);
+    if (!settings.coefficients.empty())
+      sg::predictor::read_coefficients(settings.coefficients, settings.params);
+    return run(common.lcm_url, settings.params);
   });
 }

@@ -73,98 +73,124 @@ void CameraSimulator::render(int64_t index, const ArmState& arm, StereoFrame& fr
 
 namespace {
 
-Eigen::Vector3d vector3(const Config& c, const std::string& key, const Eigen::Vector3d& fallback) {
-  if (!c.has(key)) return fallback;
-  const auto v = c.require<std::vector<double>>(key);
-  if (v.size() != 3) throw c.error_at(key, "must be a list of 3 numbers");
-  return {v[0], v[1], v[2]};
+constexpr double kDeg = M_PI / 180;
+
+void vector3(Section& section, const std::string& key, Eigen::Vector3d& v, const Range& range,
+             const std::string& help) {
+  section.numbers(key, v.data(), 3, range, help);
 }
 
-double positive(const Config& c, const std::string& key, double fallback) {
-  const double v = c.get<double>(key, fallback);
-  if (!(v > 0) || !std::isfinite(v)) throw c.error_at(key, "must be a positive number");
-  return v;
+/// A value kept in radians, read in degrees.
+void degrees(Section& section, const std::string& key, double& radians, const Range& range,
+             const std::string& help) {
+  double deg = radians / kDeg;
+  section.number(key, deg, range, help);
+  radians = deg * kDeg;
 }
 
-double non_negative(const Config& c, const std::string& key, double fallback) {
-  const double v = c.get<double>(key, fallback);
-  if (!(v >= 0) || !std::isfinite(v)) throw c.error_at(key, "must be a number >= 0");
-  return v;
+void read_rig(const Config& config, RigParams& r) {
+  Section c(config, "rig");
+  vector3(c, "target", r.target, Range::finite(), "where the optical axes meet, robot frame (m)");
+  c.number("baseline", r.baseline, Range::above(0), "m between the camera centres");
+  degrees(c, "toe_in_deg", r.toe_in, Range::above_to(0, 89.9), "each camera turned inward");
+  degrees(c, "pitch_deg", r.pitch, Range::closed(-90, 90), "the rig's elevation over the target");
+  degrees(c, "azimuth_deg", r.azimuth, Range::closed(-360, 360),
+          "direction from the target to the rig (0: from +X)");
+  c.number("width", r.width, Range::closed(16, 16384), "image width (px)");
+  c.number("height", r.height, Range::closed(16, 16384), "image height (px)");
+  c.number("fx", r.intrinsics.fx, Range::above(0), "focal length (px)");
+  c.number("fy", r.intrinsics.fy, Range::above(0), "focal length (px)");
+  r.intrinsics.cx = (r.width - 1) / 2.0;  // the image centre unless given
+  r.intrinsics.cy = (r.height - 1) / 2.0;
+  c.number("cx", r.intrinsics.cx, Range::finite(), "principal point (px)");
+  c.number("cy", r.intrinsics.cy, Range::finite(), "principal point (px)");
+  double d[5] = {r.distortion.k1, r.distortion.k2, r.distortion.p1, r.distortion.p2,
+                 r.distortion.k3};
+  c.numbers("distortion", d, 5, Range::finite(), "k1 k2 p1 p2 k3 (OpenCV's model)");
+  r.distortion = {d[0], d[1], d[2], d[3], d[4]};
+  c.done();
+}
+
+void read_scenario(const Config& config, ScenarioParams& s) {
+  Section c(config, "scenario");
+  c.choice("kind", s.kind, scenario_kinds(), "how the ball moves");
+  vector3(c, "centre", s.centre, Range::finite(), "m, robot frame");
+  c.number("radius", s.radius, Range::at_least(0), "m (paper, circle, figure8)");
+  c.number("rpm", s.rpm, Range::finite(), "revolutions per minute");
+  degrees(c, "phase_deg", s.phase, Range::finite(), "the starting phase (default: from the seed)");
+  c.number("drift_speed", s.drift_speed, Range::at_least(0),
+           "paper: back-and-forth along Y (m/s)");
+  c.number("drift_half_period", s.drift_half_period, Range::above(0),
+           "s between the drift's reversals");
+  vector3(c, "line_direction", s.line_direction, Range::finite(), "line: its direction");
+  c.number("line_half_length", s.line_half_length, Range::above(0), "line: m each way");
+  c.number("line_speed", s.line_speed, Range::above(0), "line: m/s");
+  c.number("random_extent", s.random_extent, Range::above(0), "random: m from the centre");
+  c.number("random_speed", s.random_speed, Range::above(0), "random: m/s");
+  int64_t seed = static_cast<int64_t>(s.seed);
+  c.number("seed", seed, Range::at_least(0), "the starting phase, noise, distractors");
+  s.seed = static_cast<uint64_t>(seed);
+  c.done();
+  try {
+    make_scenario(s);
+  } catch (const std::invalid_argument& e) {
+    throw c.error("kind", e.what());
+  }
+}
+
+void read_occlusion(const Config& config, OcclusionParams& o) {
+  Section c(config, "occlusion");
+  std::vector<std::vector<double>> episodes;
+  if (c.read("episodes", episodes, "[]", "[start_s, duration_s] pairs", 0)) {
+    for (const auto& e : episodes) {
+      if (e.size() != 2 || !std::isfinite(e[0]) || !(e[1] >= 0 && std::isfinite(e[1])))
+        throw c.error("episodes", "must be a list of [start_s, duration_s] pairs");
+      o.episodes.push_back({e[0], e[1]});
+    }
+  }
+  c.number("transition", o.transition, Range::at_least(0), "s to slide in and out");
+  c.number("standoff", o.standoff, Range::above(0), "panel distance from the ball (m)");
+  c.number("width", o.width, Range::above(0), "panel width (m)");
+  c.number("height", o.height, Range::above(0), "panel height (m)");
+  c.done();
+}
+
+void read_lighting(const Config& config, LightingParams& l) {
+  Section c(config, "lighting");
+  c.number("gain_amplitude", l.gain_amplitude, Range::at_least(0), "exposure gain 1 +- this");
+  c.number("gain_period", l.gain_period, Range::above(0), "s");
+  c.number("colour_amplitude", l.colour_amplitude, Range::at_least(0),
+           "colour balance drift per channel");
+  c.number("colour_period", l.colour_period, Range::above(0), "s");
+  c.done();
+}
+
+void read_camera_sim(const Config& config, SimParams& p) {
+  Section c(config, "camera_sim");
+  c.number("rate_hz", p.frame_rate, Range::above_to(0, 1000), "frames per second");
+  c.choice("encoding", p.encoding, {"jpeg", "raw"}, "image_t encoding on the bus");
+  c.number("ball_radius", p.ball_radius, Range::above(0), "m");
+  c.number("noise_sigma", p.noise_sigma, Range::at_least(0), "sensor noise, grey levels");
+  c.number("distractors", p.scene.distractors, Range::closed(0, 1000),
+           "small red stickers of the ball's hue");
+  c.number("exposure", p.exposure, Range::at_least(0), "s; blurs the moving ball");
+  c.number("motion_blur_samples", p.motion_blur_samples, Range::closed(1, 64),
+           "renders averaged over the exposure");
+  c.number("min_visible_px", p.min_visible_px, Range::at_least(0),
+           "a camera sees the ball above this area (px)");
+  c.done();
 }
 
 }  // namespace
 
 SimParams load_sim_params(const Config& c) {
   SimParams p;
-  constexpr double kDeg = M_PI / 180;
-  RigParams& r = p.rig;
-  r.target = vector3(c, "rig.target", r.target);
-  r.baseline = positive(c, "rig.baseline", r.baseline);
-  r.toe_in = positive(c, "rig.toe_in_deg", r.toe_in / kDeg) * kDeg;
-  if (r.toe_in >= M_PI / 2) throw c.error_at("rig.toe_in_deg", "must be below 90");
-  r.pitch = c.get<double>("rig.pitch_deg", r.pitch / kDeg) * kDeg;
-  r.azimuth = c.get<double>("rig.azimuth_deg", r.azimuth / kDeg) * kDeg;
-  r.width = static_cast<int>(positive(c, "rig.width", r.width));
-  r.height = static_cast<int>(positive(c, "rig.height", r.height));
-  r.intrinsics.fx = positive(c, "rig.fx", r.intrinsics.fx);
-  r.intrinsics.fy = positive(c, "rig.fy", r.intrinsics.fy);
-  r.intrinsics.cx = c.get<double>("rig.cx", (r.width - 1) / 2.0);
-  r.intrinsics.cy = c.get<double>("rig.cy", (r.height - 1) / 2.0);
-  if (c.has("rig.distortion")) {
-    const auto d = c.require<std::vector<double>>("rig.distortion");
-    if (d.size() != 5) throw c.error_at("rig.distortion", "must be 5 numbers: k1 k2 p1 p2 k3");
-    r.distortion = {d[0], d[1], d[2], d[3], d[4]};
-  }
-
-  ScenarioParams& s = p.scenario;
-  s.kind = c.get<std::string>("scenario.kind", s.kind);
-  s.centre = vector3(c, "scenario.centre", s.centre);
-  s.radius = non_negative(c, "scenario.radius", s.radius);
-  s.rpm = c.get<double>("scenario.rpm", s.rpm);
-  s.phase = c.has("scenario.phase_deg") ? c.require<double>("scenario.phase_deg") * kDeg : s.phase;
-  s.drift_speed = non_negative(c, "scenario.drift_speed", s.drift_speed);
-  s.drift_half_period = positive(c, "scenario.drift_half_period", s.drift_half_period);
-  s.line_direction = vector3(c, "scenario.line_direction", s.line_direction);
-  s.line_half_length = positive(c, "scenario.line_half_length", s.line_half_length);
-  s.line_speed = positive(c, "scenario.line_speed", s.line_speed);
-  s.random_extent = positive(c, "scenario.random_extent", s.random_extent);
-  s.random_speed = positive(c, "scenario.random_speed", s.random_speed);
-  s.seed = static_cast<uint64_t>(c.get<int64_t>("scenario.seed", static_cast<int64_t>(s.seed)));
-  try {
-    make_scenario(s);
-  } catch (const std::invalid_argument& e) {
-    throw c.error_at("scenario.kind", e.what());
-  }
-
-  OcclusionParams& o = p.occlusion;
-  if (c.has("occlusion.episodes")) {
-    const auto flat = c.require<std::vector<std::vector<double>>>("occlusion.episodes");
-    for (const auto& e : flat) {
-      if (e.size() != 2 || !(e[1] >= 0))
-        throw c.error_at("occlusion.episodes", "must be a list of [start_s, duration_s] pairs");
-      o.episodes.push_back({e[0], e[1]});
-    }
-  }
-  o.transition = non_negative(c, "occlusion.transition", o.transition);
-  o.standoff = positive(c, "occlusion.standoff", o.standoff);
-  o.width = positive(c, "occlusion.width", o.width);
-  o.height = positive(c, "occlusion.height", o.height);
-
-  LightingParams& l = p.lighting;
-  l.gain_amplitude = non_negative(c, "lighting.gain_amplitude", l.gain_amplitude);
-  l.gain_period = positive(c, "lighting.gain_period", l.gain_period);
-  l.colour_amplitude = non_negative(c, "lighting.colour_amplitude", l.colour_amplitude);
-  l.colour_period = positive(c, "lighting.colour_period", l.colour_period);
-
-  p.scene.distractors =
-      static_cast<int>(non_negative(c, "camera_sim.distractors", p.scene.distractors));
-  p.scene.seed = s.seed;
-  p.ball_radius = positive(c, "camera_sim.ball_radius", p.ball_radius);
-  p.noise_sigma = non_negative(c, "camera_sim.noise_sigma", p.noise_sigma);
-  p.exposure = non_negative(c, "camera_sim.exposure", p.exposure);
-  p.motion_blur_samples = static_cast<int>(positive(c, "camera_sim.motion_blur_samples", 1));
-  p.frame_rate = positive(c, "camera_sim.rate_hz", p.frame_rate);
-  p.min_visible_px = non_negative(c, "camera_sim.min_visible_px", p.min_visible_px);
+  read_rig(c, p.rig);
+  read_scenario(c, p.scenario);
+  read_occlusion(c, p.occlusion);
+  read_lighting(c, p.lighting);
+  read_camera_sim(c, p);
+  p.scene.seed = p.scenario.seed;
   return p;
 }
 

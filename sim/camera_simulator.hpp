@@ -20,7 +20,8 @@ struct LightingParams {
   double colour_period = 45.0;     ///< s
 };
 
-/// Everything the camera simulator needs; `load_sim_params` reads it from a Config.
+/// Everything the camera simulator needs; `load_sim_params` reads it from a Config (sections
+/// rig, scenario, occlusion, lighting, camera_sim; every key range-checked, unknown keys refused).
 struct SimParams {
   RigParams rig;
   ScenarioParams scenario;
@@ -33,6 +34,7 @@ struct SimParams {
   int motion_blur_samples = 1;
   double frame_rate = 30.0;      ///< Hz
   double min_visible_px = 10.0;  ///< a camera "sees" the ball when this much of it shows
+  std::string encoding = "jpeg";  ///< image_t encoding sg-camera-sim publishes: jpeg or raw
 };
 
 /// One rendered stereo pair and the truth behind it.

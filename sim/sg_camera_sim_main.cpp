@@ -31,17 +31,13 @@ namespace {
 using namespace std::chrono;
 
 struct Options {
-  double rate_hz = 0;  // 0: from config
   bool fast = false;
   int64_t frames = 0;
-  std::string encoding;  // jpeg or raw; "" from config
   int jpeg_quality = 90;
   std::string write_dir;
   std::string snapshot;
   int64_t snapshot_frame = 0;
   std::string calibration_out;
-  std::string scenario;
-  int64_t seed = -1;
   std::vector<std::string> occlusions;
 };
 
@@ -171,12 +167,12 @@ int main(int argc, char** argv) {
   sg::CommonOptions common;
   sg::add_common_options(app, common);
   Options o;
-  app.add_option("--rate", o.rate_hz, "frames per second (default 30, config camera_sim.rate_hz)");
+  const auto keys = sg::declared_keys(sg::sim::load_sim_params);
+  common.flags.add(app, "--rate", "camera_sim.rate_hz", keys);
   app.add_flag("--fast", o.fast,
                "render as fast as possible (simulated time) instead of real time");
   app.add_option("--frames", o.frames, "stop after this many stereo frames (0: until Ctrl-C)");
-  app.add_option("--encoding", o.encoding, "image_t encoding: jpeg (default) or raw")
-      ->check(CLI::IsMember({"jpeg", "raw"}));
+  common.flags.add(app, "--encoding", "camera_sim.encoding", keys);
   app.add_option("--jpeg-quality", o.jpeg_quality, "JPEG quality")->check(CLI::Range(1, 100));
   app.add_option("--write", o.write_dir,
                  "write DIR/left.avi, right.avi, ground_truth.csv, calibration.yaml instead of "
@@ -185,20 +181,14 @@ int main(int argc, char** argv) {
   app.add_option("--snapshot-frame", o.snapshot_frame, "frame to snapshot (default 0)");
   app.add_option("--calibration-out", o.calibration_out,
                  "also write the simulator's true calibration to this file");
-  app.add_option("--scenario", o.scenario, "motion: paper, circle, line, figure8, random, still");
-  app.add_option("--seed", o.seed, "seed for the scenario, noise and distractors");
+  common.flags.add(app, "--scenario", "scenario.kind", keys);
+  common.flags.add(app, "--seed", "scenario.seed", keys);
   app.add_option("--occlusion", o.occlusions,
                  "a total occlusion START:DURATION in seconds (repeatable)");
 
   return sg::run_program(app, argc, argv, [&] {
     const sg::Config config = sg::load_common(common);
     sg::sim::SimParams params = sg::sim::load_sim_params(config);
-    if (o.rate_hz != 0) {
-      if (!(o.rate_hz > 0)) throw std::runtime_error("--rate must be positive");
-      params.frame_rate = o.rate_hz;
-    }
-    if (!o.scenario.empty()) params.scenario.kind = o.scenario;
-    if (o.seed >= 0) params.scenario.seed = params.scene.seed = static_cast<uint64_t>(o.seed);
     for (const std::string& spec : o.occlusions) {
       double start = 0, duration = 0;
       char colon = 0;
@@ -207,8 +197,7 @@ int main(int argc, char** argv) {
         throw std::runtime_error("--occlusion '" + spec + "': expected START:DURATION in seconds");
       params.occlusion.episodes.push_back({start, duration});
     }
-    const bool jpeg = (o.encoding.empty() ? config.get<std::string>("camera_sim.encoding", "jpeg")
-                                          : o.encoding) != "raw";
+    const bool jpeg = params.encoding != "raw";
     sg::install_shutdown_handlers();
     sg::sim::CameraSimulator sim(params);
     if (!o.calibration_out.empty()) write_true_calibration(sim, o.calibration_out);

@@ -17,43 +17,42 @@ double lerp(double a, double b, int i, int n) {
   return n == 1 ? (a + b) / 2 : a + (b - a) * i / (n - 1);
 }
 
-Eigen::Vector3d vector3(const Config& c, const std::string& key, const Eigen::Vector3d& fallback) {
-  if (!c.has(key)) return fallback;
-  const auto v = c.require<std::vector<double>>(key);
-  if (v.size() != 3 || !std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
-    throw c.error_at(key, "must be a list of 3 finite numbers");
-  return {v[0], v[1], v[2]};
-}
-
 }  // namespace
 
 Eigen::Vector3d tool_down_rpy(const Eigen::Vector3d& position) {
   return {M_PI, 0.0, std::remainder(std::atan2(position.y(), position.x()) + M_PI, 2 * M_PI)};
 }
 
-RobotCalibrationParams load_robot_calibration_params(const Config& c) {
+RobotCalibrationParams load_robot_calibration_params(const Config& config) {
   RobotCalibrationParams p;
-  const std::string s = "calibrate_robot.";
-  p.box_min = vector3(c, s + "box_min", p.box_min);
-  p.box_max = vector3(c, s + "box_max", p.box_max);
+  Section c(config, "calibrate_robot");
+  c.numbers("box_min", p.box_min.data(), 3, Range::finite(),
+            "a corner of the grid of the tool centre point, robot frame (m)");
+  c.numbers("box_max", p.box_max.data(), 3, Range::finite(), "the opposite corner (m)");
   if (!(p.box_min.array() <= p.box_max.array()).all())
-    throw c.error_at(s + "box_max", "must be at least box_min on every axis");
-  if (c.has(s + "grid")) {
-    const auto g = c.require<std::vector<int>>(s + "grid");
+    throw c.error("box_max", "must be at least box_min on every axis");
+  std::vector<int> g = {p.nx, p.ny, p.nz};
+  const std::string grid_default = show({1.0 * p.nx, 1.0 * p.ny, 1.0 * p.nz});
+  if (c.read("grid", g, grid_default, "points per axis nx ny nz (nz >= 2, 12 in all)", 3)) {
     if (g.size() != 3 || g[0] < 1 || g[1] < 1 || g[2] < 2 || g[0] * g[1] * g[2] < 12)
-      throw c.error_at(s + "grid", "must be [nx, ny, nz], nz >= 2, at least 12 points");
+      throw c.error("grid", "must be [nx, ny, nz], nz >= 2, at least 12 points");
     p.nx = g[0], p.ny = g[1], p.nz = g[2];
   }
-  if (c.has(s + "tool_rpy")) p.tool_rpy = vector3(c, s + "tool_rpy", {});
-  p.ball_offset = vector3(c, s + "ball_offset", p.ball_offset);
-  p.speed = c.get<double>(s + "speed", p.speed);
-  if (!(p.speed > 0 && p.speed <= 1)) throw c.error_at(s + "speed", "must be in (0, 1]");
-  p.frames_per_stop = c.get<int>(s + "frames_per_stop", p.frames_per_stop);
-  if (p.frames_per_stop < 1) throw c.error_at(s + "frames_per_stop", "must be at least 1");
-  p.settle = c.get<double>(s + "settle", p.settle);
-  if (!(p.settle >= 0)) throw c.error_at(s + "settle", "must be >= 0 seconds");
-  p.max_misses_per_stop = c.get<int>(s + "max_misses_per_stop", p.max_misses_per_stop);
-  if (p.max_misses_per_stop < 1) throw c.error_at(s + "max_misses_per_stop", "must be >= 1");
+  Eigen::Vector3d rpy(M_PI, 0, 0);
+  const bool rpy_given = c.known("tool_rpy", "pi 0 atan2(y,x)+pi",
+                                 "tool roll pitch yaw at every stop (rad)", 3);
+  c.numbers("tool_rpy", rpy.data(), 3, Range::finite(), "tool roll pitch yaw at every stop (rad)");
+  if (rpy_given) p.tool_rpy = rpy;
+  c.numbers("ball_offset", p.ball_offset.data(), 3, Range::finite(),
+            "the ball's centre from the tool centre point, tool frame (m)");
+  c.number("speed", p.speed, Range::above_to(0, 1), "arm speed, fraction of the joint limits");
+  c.number("frames_per_stop", p.frames_per_stop, Range::at_least(1),
+           "blobs averaged per camera at each stop");
+  c.number("settle", p.settle, Range::at_least(0), "s after arrival before blobs count");
+  c.number("max_misses_per_stop", p.max_misses_per_stop, Range::at_least(1),
+           "frames without the ball before a stop is skipped");
+  c.number("timeout", p.timeout, Range::above(0), "s without progress before giving up");
+  c.done();
   return p;
 }
 

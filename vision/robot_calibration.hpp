@@ -30,6 +30,7 @@ struct RobotCalibrationParams {
   int frames_per_stop = 10;              ///< blobs averaged per camera at each stop
   double settle = 0.5;                   ///< s after arrival before blobs count
   int max_misses_per_stop = 60;          ///< frames without the ball before a stop is skipped
+  double timeout = 30;                   ///< s without progress before sg-calibrate gives up
   int image_width = 640, image_height = 480;
 };
 

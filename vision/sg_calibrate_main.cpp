@@ -167,7 +167,8 @@ int run_register(const std::string& calibration_path, const std::string& points_
 }
 
 int run_robot(const std::string& url, const sg::vision::RobotCalibrationParams& params,
-              double timeout_s, const std::string& out) {
+              const std::string& out) {
+  const double timeout_s = params.timeout;
   sg::install_shutdown_handlers();
   sg::Bus bus(url);
   // Sequence numbers from the clock, so they are newer than any the driver has seen.
@@ -256,6 +257,65 @@ int run_robot(const std::string& url, const sg::vision::RobotCalibrationParams& 
   return 0;
 }
 
+/// What the subcommands' flags give.
+struct Inputs {
+  std::string left, right, out, pattern = "9x6", calibration, points;
+  int width = 640, height = 480;
+  double square = 0.025;
+};
+
+CLI::App* add_dlt(CLI::App& app, Inputs& in) {
+  CLI::App* dlt = app.add_subcommand("dlt", "DLT from points known in the robot frame (eq. 1-6)");
+  dlt->add_option("--left", in.left, "left camera's CSV: X,Y,Z,u,v per line")->required();
+  dlt->add_option("--right", in.right, "right camera's CSV: X,Y,Z,u,v per line")->required();
+  dlt->add_option("--width", in.width, "image width (px)")->capture_default_str();
+  dlt->add_option("--height", in.height, "image height (px)")->capture_default_str();
+  dlt->add_option("--out", in.out, "calibration file to write")->required();
+  return dlt;
+}
+
+CLI::App* add_checkerboard(CLI::App& app, Inputs& in) {
+  CLI::App* board = app.add_subcommand(
+      "checkerboard", "Intrinsics, distortion and stereo extrinsics from board images");
+  board->add_option("--left", in.left, "folder of left images")->required();
+  board->add_option("--right", in.right, "folder of right images (paired by sorted name)")
+      ->required();
+  board->add_option("--pattern", in.pattern, "inner corners COLSxROWS")->capture_default_str();
+  board->add_option("--square", in.square, "side of a square (m)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  board->add_option("--out", in.out, "calibration file to write")->required();
+  return board;
+}
+
+/// The robot subcommand: its flags stand for `calibrate_robot` keys (the flag wins).
+CLI::App* add_robot(CLI::App& app, Inputs& in, sg::ConfigFlags& flags) {
+  CLI::App* robot = app.add_subcommand(
+      "robot", "Arm-guided: the arm carries the ball through a grid (section 4)");
+  robot->add_option("--out", in.out, "calibration file to write")->required();
+  robot->add_option("--width", in.width, "image width (px)")->capture_default_str();
+  robot->add_option("--height", in.height, "image height (px)")->capture_default_str();
+  const auto keys = sg::declared_keys(sg::vision::load_robot_calibration_params);
+  for (const char* key : {"frames_per_stop", "settle", "speed", "timeout", "box_min", "box_max",
+                          "grid", "ball_offset", "tool_rpy"}) {
+    std::string flag = std::string("--") + key;
+    std::replace(flag.begin(), flag.end(), '_', '-');
+    flags.add(*robot, flag, std::string("calibrate_robot.") + key, keys);
+  }
+  return robot;
+}
+
+CLI::App* add_register(CLI::App& app, Inputs& in) {
+  CLI::App* reg = app.add_subcommand("register", "Move a calibration into the robot's frame");
+  reg->add_option("--calibration", in.calibration, "calibration in the cameras' frame")
+      ->required();
+  reg->add_option("--points", in.points,
+                  "CSV: X,Y,Z (robot frame), u_left,v_left,u_right,v_right")
+      ->required();
+  reg->add_option("--out", in.out, "calibration file to write")->required();
+  return reg;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -264,88 +324,23 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   sg::CommonOptions common;
   sg::add_common_options(app, common);
-  std::string left, right, out, pattern = "9x6", calibration, points;
-  int width = 640, height = 480;
-  double square = 0.025;
-
-  CLI::App* dlt = app.add_subcommand("dlt", "DLT from points known in the robot frame (eq. 1-6)");
-  dlt->add_option("--left", left, "left camera's CSV: X,Y,Z,u,v per line")->required();
-  dlt->add_option("--right", right, "right camera's CSV: X,Y,Z,u,v per line")->required();
-  dlt->add_option("--width", width, "image width (px)");
-  dlt->add_option("--height", height, "image height (px)");
-  dlt->add_option("--out", out, "calibration file to write")->required();
-
-  CLI::App* board = app.add_subcommand(
-      "checkerboard", "Intrinsics, distortion and stereo extrinsics from board images");
-  board->add_option("--left", left, "folder of left images")->required();
-  board->add_option("--right", right, "folder of right images (paired by sorted name)")->required();
-  board->add_option("--pattern", pattern, "inner corners COLSxROWS (default 9x6)");
-  board->add_option("--square", square, "side of a square (m)")->check(CLI::PositiveNumber);
-  board->add_option("--out", out, "calibration file to write")->required();
-
-  sg::vision::RobotCalibrationParams robot_params;
-  double timeout_s = 30;
-  std::vector<double> box_min, box_max, ball_offset, tool_rpy;
-  std::vector<int> grid;
-  CLI::App* robot = app.add_subcommand(
-      "robot", "Arm-guided: the arm carries the ball through a grid (section 4)");
-  robot->add_option("--out", out, "calibration file to write")->required();
-  robot->add_option("--frames-per-stop", robot_params.frames_per_stop,
-                    "blobs averaged per camera at each stop");
-  robot->add_option("--settle", robot_params.settle, "seconds after arrival before blobs count");
-  robot->add_option("--speed", robot_params.speed, "arm speed, fraction of maximum");
-  robot->add_option("--width", robot_params.image_width, "image width (px)");
-  robot->add_option("--height", robot_params.image_height, "image height (px)");
-  robot->add_option("--timeout", timeout_s, "give up after this many seconds without progress");
-  robot->add_option("--box-min", box_min, "grid corner X Y Z, robot frame (m)")->expected(3);
-  robot->add_option("--box-max", box_max, "opposite grid corner X Y Z (m)")->expected(3);
-  robot->add_option("--grid", grid, "points per axis NX NY NZ (NZ >= 2, 12 in all)")->expected(3);
-  robot
-      ->add_option("--ball-offset", ball_offset,
-                   "ball centre from the tool centre point X Y Z, tool frame (m)")
-      ->expected(3);
-  robot
-      ->add_option("--tool-rpy", tool_rpy,
-                   "tool roll pitch yaw at every stop, rad (default: pointing down, pi 0 "
-                   "atan2(Y,X)+pi)")
-      ->expected(3);
-
-  CLI::App* reg = app.add_subcommand("register", "Move a calibration into the robot's frame");
-  reg->add_option("--calibration", calibration, "calibration in the cameras' frame")->required();
-  reg->add_option("--points", points, "CSV: X,Y,Z (robot frame), u_left,v_left,u_right,v_right")
-      ->required();
-  reg->add_option("--out", out, "calibration file to write")->required();
-
+  Inputs in;
+  CLI::App* dlt = add_dlt(app, in);
+  CLI::App* board = add_checkerboard(app, in);
+  CLI::App* robot = add_robot(app, in, common.flags);
+  add_register(app, in);
   return sg::run_program(app, argc, argv, [&] {
     const sg::Config config = sg::load_common(common);
+    // Read in every mode, so a typo in calibrate_robot is caught by any sg-calibrate.
+    sg::vision::RobotCalibrationParams robot_params =
+        sg::vision::load_robot_calibration_params(config);
     if (*robot) {
-      // The config's calibrate_robot section, then the flags given.
-      sg::vision::RobotCalibrationParams p = sg::vision::load_robot_calibration_params(config);
-      auto given = [&](const char* flag) { return robot->count(flag) > 0; };
-      if (given("--frames-per-stop")) p.frames_per_stop = robot_params.frames_per_stop;
-      if (given("--settle")) p.settle = robot_params.settle;
-      if (given("--speed")) p.speed = robot_params.speed;
-      p.image_width = robot_params.image_width;
-      p.image_height = robot_params.image_height;
-      auto vec = [](const std::vector<double>& v) { return Eigen::Vector3d(v[0], v[1], v[2]); };
-      if (!box_min.empty()) p.box_min = vec(box_min);
-      if (!box_max.empty()) p.box_max = vec(box_max);
-      if (!ball_offset.empty()) p.ball_offset = vec(ball_offset);
-      if (!tool_rpy.empty()) p.tool_rpy = vec(tool_rpy);
-      if (!grid.empty()) p.nx = grid[0], p.ny = grid[1], p.nz = grid[2];
-      if (!(p.box_min.array() <= p.box_max.array()).all())
-        throw std::runtime_error("--box-min must be at most --box-max on every axis");
-      if (!(p.speed > 0 && p.speed <= 1)) throw std::runtime_error("--speed must be in (0, 1]");
-      if (!given("--timeout")) timeout_s = config.get<double>("calibrate_robot.timeout", timeout_s);
-      try {
-        sg::vision::RobotCalibration check(p);
-      } catch (const CalibrationInputError& e) {
-        throw std::runtime_error(std::string("--grid: ") + e.what());
-      }
-      return run_robot(common.lcm_url, p, timeout_s, out);
+      robot_params.image_width = in.width;
+      robot_params.image_height = in.height;
+      return run_robot(common.lcm_url, robot_params, in.out);
     }
-    if (*dlt) return run_dlt(left, right, width, height, out);
-    if (*board) return run_checkerboard(left, right, pattern, square, out);
-    return run_register(calibration, points, out);
+    if (*dlt) return run_dlt(in.left, in.right, in.width, in.height, in.out);
+    if (*board) return run_checkerboard(in.left, in.right, in.pattern, in.square, in.out);
+    return run_register(in.calibration, in.points, in.out);
   });
 }

@@ -259,8 +259,9 @@ int main(int argc, char** argv) {
   return sg::run_program(app, argc, argv, [&] {
     const sg::Config config = sg::load_common(common);
     if (*learn) return learn_color(learn_image, learn_roi);
-    const auto params = sg::vision::load_tracker_params(config);
-    if (o.calibration.empty()) o.calibration = config.get<std::string>("vision.calibration", "");
+    const sg::vision::VisionSettings settings = sg::vision::read_vision_settings(config);
+    const auto& params = settings.tracker;
+    if (o.calibration.empty()) o.calibration = settings.calibration;
     std::optional<sg::vision::StereoCalibration> calibration;
     if (!o.calibration.empty()) calibration = sg::vision::read_calibration(o.calibration);
     if (o.publish_images && o.source == "lcm")

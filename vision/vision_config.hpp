@@ -1,12 +1,25 @@
 #pragma once
 
+#include <string>
+
 #include "common/config.hpp"
 #include "vision/blob_tracker.hpp"
 
 namespace sg::vision {
 
-/// Reads the tracker's parameters from the `vision` section (colour ranges, window, minimum
-/// area); every key optional. Throws ConfigError naming a bad key.
-BlobTracker::Params load_tracker_params(const Config& config);
+/// What sg-vision is configured with: the `vision` section (docs/vision.md).
+struct VisionSettings {
+  BlobTracker::Params tracker;
+  std::string calibration;  ///< a stereo calibration file; with it OBJECT_POSITION is published
+};
+
+/// Reads the `vision` section: every key range-checked, any other key of the section refused
+/// with the nearest known one. Absent keys keep the structs' defaults.
+VisionSettings read_vision_settings(const Config& config);
+
+/// The tracker's part of read_vision_settings().
+inline BlobTracker::Params load_tracker_params(const Config& config) {
+  return read_vision_settings(config).tracker;
+}
 
 }  // namespace sg::vision

@@ -1,0 +1,35 @@
+#include "grasp/grasp_settings.hpp"
+
+namespace sg::grasp {
+
+GraspSettings read_grasp_settings(const Config& config) {
+  GraspSettings s;
+  InterceptionSettings& i = s.interception;
+  Section g(config, "grasp");
+  g.number("standoff", s.standoff, Range::closed(0, 0.5), "m above the ball while tracking");
+  g.number("lift", s.lift, Range::above_to(0, 0.5), "m the object is lifted (a3)");
+  g.number("backoff", s.backoff, Range::closed(0, 0.5),
+           "m the tool rises when the track is lost during an approach");
+  g.number("speed", s.speed, Range::above_to(0, 1), "fraction of the joint speed limits");
+  g.number("max_trajectory_age", s.max_trajectory_age, Range::above(0),
+           "s: an older OBJECT_TRAJECTORY gives no command");
+  g.number("success_distance", s.success_distance, Range::above(0),
+           "m: after the lift, the measured ball this close to the tool = held");
+  g.number("judge_time", s.judge_time, Range::above(0),
+           "s after the arm stops: no sighting that close by then = not held");
+  g.number("default_delay", s.default_delay, Range::above(0),
+           "s per controller command until ARM_STATUS has measured one");
+  g.flag("use_prediction", s.use_prediction,
+         "false: aim at the last measured position (the baseline)");
+  g.number("table_z", i.table_z, Range::finite(), "m: the table top in the robot's frame");
+  g.number("table_margin", i.table_margin, Range::at_least(0),
+           "m the tool centre point stays above the table");
+  g.number("wrist_min", i.wrist_min, Range::above(0),
+           "m: the approach leans so the wrist centre stays this far from the shoulder ...");
+  g.number("wrist_max", i.wrist_max, Range::above(0), "m: ... and no farther");
+  if (!(i.wrist_min < i.wrist_max)) throw g.error("wrist_min", "must be below wrist_max");
+  g.done();
+  return s;
+}
+
+}  // namespace sg::grasp

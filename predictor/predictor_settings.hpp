@@ -1,0 +1,24 @@
+#pragma once
+
+#include <string>
+
+#include "common/config.hpp"
+#include "predictor/trajectory_predictor.hpp"
+
+namespace sg::predictor {
+
+/// What sg-predictor is configured with: the `predictor` section (docs/prediction.md).
+struct PredictorSettings {
+  PredictorParams params;
+  std::string coefficients;  ///< an offline-trained coefficients file; "" = learn online
+};
+
+/// Reads the `predictor` section: every key range-checked, any other key of the section refused
+/// with the nearest known one. Absent keys keep PredictorParams' defaults.
+PredictorSettings read_predictor_settings(const Config& config);
+
+/// Reads a coefficients file that `sg-predictor train` wrote (order, coefficients.x/y/z) into
+/// `params` (its order becomes the Burg order). Errors name the file, line and key.
+void read_coefficients(const std::string& path, PredictorParams& params);
+
+}  // namespace sg::predictor
