@@ -182,8 +182,7 @@ void Section::numbers(const std::string& key, double* values, int n, const Range
                       const std::string& help) {
   const std::vector<double> fallback(values, values + n);
   const std::string each = range.requirement().substr(std::string("must be ").size());
-  declare(key, show(fallback), "must be " + std::to_string(n) + " numbers, each " + each, help,
-          n);
+  declare(key, show(fallback), "must be " + std::to_string(n) + " numbers, each " + each, help, n);
   const std::string full = name_ + "." + key;
   if (!config_.has(full)) return;
   const auto v = config_.require<std::vector<double>>(full);
@@ -193,8 +192,8 @@ void Section::numbers(const std::string& key, double* values, int n, const Range
   }
   for (int i = 0; i < n; ++i) {
     if (!range.contains(v[static_cast<size_t>(i)])) {
-      throw config_.error_at(full, "number " + std::to_string(i + 1) + " " +
-                                       range.requirement() + ", got " + show(v[i]));
+      throw config_.error_at(full, "number " + std::to_string(i + 1) + " " + range.requirement() +
+                                       ", got " + show(v[i]));
     }
   }
   std::copy(v.begin(), v.end(), values);

@@ -33,16 +33,15 @@ void init_logging(const std::string& program, const std::string& level) {
 
 const std::vector<std::string>& config_sections() {
   static const std::vector<std::string> sections = {
-      "bus",     "bus_check", "rig",        "scenario", "occlusion", "lighting",
-      "camera_sim", "vision", "predictor",  "arm",      "arm_driver", "c550_sim",
-      "grasp",   "calibrate_robot"};
+      "bus",    "bus_check", "rig", "scenario",   "occlusion", "lighting", "camera_sim",
+      "vision", "predictor", "arm", "arm_driver", "c550_sim",  "grasp",    "calibrate_robot"};
   return sections;
 }
 
 CLI::Option* ConfigFlags::add(CLI::App& app, const std::string& flag, const std::string& key,
                               const std::vector<KeyInfo>& keys) {
-  const auto info = std::find_if(keys.begin(), keys.end(),
-                                 [&](const KeyInfo& k) { return k.key == key; });
+  const auto info =
+      std::find_if(keys.begin(), keys.end(), [&](const KeyInfo& k) { return k.key == key; });
   if (info == keys.end()) throw std::logic_error(flag + ": no reader declares key '" + key + "'");
   Bound& b = bound_.emplace_back(Bound{flag, key, {}, false, nullptr});
   std::string help = info->help + " (config " + key;
@@ -54,9 +53,8 @@ CLI::Option* ConfigFlags::add(CLI::App& app, const std::string& flag, const std:
   return b.option;
 }
 
-CLI::Option* ConfigFlags::add_switch(CLI::App& app, const std::string& flag,
-                                     const std::string& key, const std::string& value,
-                                     const std::string& help) {
+CLI::Option* ConfigFlags::add_switch(CLI::App& app, const std::string& flag, const std::string& key,
+                                     const std::string& value, const std::string& help) {
   Bound& b = bound_.emplace_back(Bound{flag, key, {value}, true, nullptr});
   const std::string description = help + " (config " + key + ": " + value + ")";
   b.option = app.add_flag(flag, description);

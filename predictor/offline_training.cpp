@@ -87,10 +87,10 @@ TrainedCoefficients train_coefficients(const std::vector<Measurement>& measureme
 void write_coefficients(const std::string& path, const TrainedCoefficients& t,
                         const std::string& source) {
   YAML::Emitter yaml;
-  yaml << YAML::BeginMap << YAML::Key << "order" << YAML::Value << t.order << YAML::Key
-       << "period" << YAML::Value << t.period << YAML::Key << "samples" << YAML::Value
-       << t.samples << YAML::Key << "source" << YAML::Value << source << YAML::Key
-       << "coefficients" << YAML::Value << YAML::BeginMap;
+  yaml << YAML::BeginMap << YAML::Key << "order" << YAML::Value << t.order << YAML::Key << "period"
+       << YAML::Value << t.period << YAML::Key << "samples" << YAML::Value << t.samples << YAML::Key
+       << "source" << YAML::Value << source << YAML::Key << "coefficients" << YAML::Value
+       << YAML::BeginMap;
   const char* axes[3] = {"x", "y", "z"};
   for (size_t i = 0; i < 3; ++i) {
     yaml << YAML::Key << axes[i] << YAML::Value << YAML::Flow << YAML::Precision(17)

@@ -79,8 +79,8 @@ int train(const std::string& input, const std::string& channel, const PredictorP
                 trained.error_power[i].front());
   }
   sg::predictor::write_coefficients(out, trained, input);
-  std::printf("trained order %d on %d samples from %s; wrote %s\n", trained.order,
-              trained.samples, input.c_str(), out.c_str());
+  std::printf("trained order %d on %d samples from %s; wrote %s\n", trained.order, trained.samples,
+              input.c_str(), out.c_str());
   return 0;
 }
 

@@ -73,8 +73,7 @@ int C550SimShell::run() {
     wait(std::min(next_state, next_event()) - now());
     serve(now());
   }
-  spdlog::info("stopping: {} bytes garbled, {} ACKs dropped", faults_.garbled(),
-               faults_.dropped());
+  spdlog::info("stopping: {} bytes garbled, {} ACKs dropped", faults_.garbled(), faults_.dropped());
   return 0;
 }
 
@@ -119,8 +118,7 @@ double C550SimShell::next_event() const {
 void C550SimShell::wait(double seconds) {
   const int timeout_ms = static_cast<int>(std::clamp(std::ceil(seconds * 1000), 0.0, 5.0));
   pollfd fds[2] = {{bus_.lcm().getFileno(), POLLIN, 0}, {-1, 0, 0}};
-  if (pty_)
-    fds[1] = {pty_->master(), static_cast<short>(POLLIN | (tx_.empty() ? 0 : POLLOUT)), 0};
+  if (pty_) fds[1] = {pty_->master(), static_cast<short>(POLLIN | (tx_.empty() ? 0 : POLLOUT)), 0};
   if (::poll(fds, pty_ ? 2 : 1, timeout_ms) < 0 && errno != EINTR) {
     throw std::runtime_error(system_error("poll"));
   }

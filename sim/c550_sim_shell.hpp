@@ -18,8 +18,7 @@
 namespace sg::sim {
 
 /// The arm's true state at `t` (s since start) as SIM_ARM_STATE, stamped `utime`.
-stereograsp::sim_arm_state_t arm_state_message(const C550Controller& c550, double t,
-                                               int64_t utime);
+stereograsp::sim_arm_state_t arm_state_message(const C550Controller& c550, double t, int64_t utime);
 
 /// sg-c550-sim's loop: the line (a pseudo-terminal that comes and goes, with its faults) and the
 /// controller (which stays), SIM_ARM_STATE out and GROUND_TRUTH in. Time is the steady clock's

@@ -118,8 +118,7 @@ void read_scenario(const Config& config, ScenarioParams& s) {
   c.number("radius", s.radius, Range::at_least(0), "m (paper, circle, figure8)");
   c.number("rpm", s.rpm, Range::finite(), "revolutions per minute");
   degrees(c, "phase_deg", s.phase, Range::finite(), "the starting phase (default: from the seed)");
-  c.number("drift_speed", s.drift_speed, Range::at_least(0),
-           "paper: back-and-forth along Y (m/s)");
+  c.number("drift_speed", s.drift_speed, Range::at_least(0), "paper: back-and-forth along Y (m/s)");
   c.number("drift_half_period", s.drift_half_period, Range::above(0),
            "s between the drift's reversals");
   vector3(c, "line_direction", s.line_direction, Range::finite(), "line: its direction");

@@ -28,9 +28,9 @@ int main(int argc, char** argv) {
   sg::CommonOptions common;
   sg::add_common_options(app, common);
   const auto keys = sg::declared_keys(sg::sim::read_c550_sim_settings);
-  for (const char* key : {"slave", "delay_min", "delay_max", "speed", "seed", "link",
-                          "garble_rate", "drop_ack_rate", "disconnect_after", "reconnect_after",
-                          "log_commands", "state_rate"}) {
+  for (const char* key :
+       {"slave", "delay_min", "delay_max", "speed", "seed", "link", "garble_rate", "drop_ack_rate",
+        "disconnect_after", "reconnect_after", "log_commands", "state_rate"}) {
     std::string flag = std::string("--") + key;
     std::replace(flag.begin(), flag.end(), '_', '-');
     common.flags.add(app, flag, std::string("c550_sim.") + key, keys);

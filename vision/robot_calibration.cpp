@@ -39,8 +39,8 @@ RobotCalibrationParams load_robot_calibration_params(const Config& config) {
     p.nx = g[0], p.ny = g[1], p.nz = g[2];
   }
   Eigen::Vector3d rpy(M_PI, 0, 0);
-  const bool rpy_given = c.known("tool_rpy", "pi 0 atan2(y,x)+pi",
-                                 "tool roll pitch yaw at every stop (rad)", 3);
+  const bool rpy_given =
+      c.known("tool_rpy", "pi 0 atan2(y,x)+pi", "tool roll pitch yaw at every stop (rad)", 3);
   c.numbers("tool_rpy", rpy.data(), 3, Range::finite(), "tool roll pitch yaw at every stop (rad)");
   if (rpy_given) p.tool_rpy = rpy;
   c.numbers("ball_offset", p.ball_offset.data(), 3, Range::finite(),

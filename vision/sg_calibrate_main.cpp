@@ -307,10 +307,8 @@ CLI::App* add_robot(CLI::App& app, Inputs& in, sg::ConfigFlags& flags) {
 
 CLI::App* add_register(CLI::App& app, Inputs& in) {
   CLI::App* reg = app.add_subcommand("register", "Move a calibration into the robot's frame");
-  reg->add_option("--calibration", in.calibration, "calibration in the cameras' frame")
-      ->required();
-  reg->add_option("--points", in.points,
-                  "CSV: X,Y,Z (robot frame), u_left,v_left,u_right,v_right")
+  reg->add_option("--calibration", in.calibration, "calibration in the cameras' frame")->required();
+  reg->add_option("--points", in.points, "CSV: X,Y,Z (robot frame), u_left,v_left,u_right,v_right")
       ->required();
   reg->add_option("--out", in.out, "calibration file to write")->required();
   return reg;

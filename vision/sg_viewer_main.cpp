@@ -40,8 +40,8 @@ int run(const std::string& url, sg::vision::ViewerSession& session, int64_t max_
   bus.subscribe<blob_t>("BLOB_(LEFT|RIGHT)", [&](const blob_t& b, const sg::ReceiveInfo& info) {
     session.on_blob(info.channel == "BLOB_LEFT" ? 0 : 1, b);
   });
-  bus.subscribe<stereograsp::point3_t>(
-      "OBJECT_POSITION", [&](const auto& p, const auto&) { session.on_position(p); });
+  bus.subscribe<stereograsp::point3_t>("OBJECT_POSITION",
+                                       [&](const auto& p, const auto&) { session.on_position(p); });
   bus.subscribe<stereograsp::trajectory_t>(
       "OBJECT_TRAJECTORY", [&](const auto& t, const auto&) { session.on_trajectory(t); });
   bus.subscribe<stereograsp::grasp_status_t>(

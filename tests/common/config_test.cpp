@@ -109,7 +109,6 @@ TEST(Config, ShippedDefaultsParse) {
   EXPECT_GT(config.require<int64_t>("bus_check.count"), 0);
 }
 
-
 // A key no reader knows names the file, its line and column, the key and the nearest known key.
 TEST(Config, UnknownKeyIsNamedWithTheNearest) {
   const Config config = Config::parse("grasp:\n  standoff: 0.1\n  stanoff: 0.2\n", "lab.yaml");
@@ -121,8 +120,9 @@ TEST(Config, UnknownKeyIsNamedWithTheNearest) {
     grasp.done();
     FAIL() << "no error";
   } catch (const ConfigError& e) {
-    EXPECT_STREQ(e.what(), "lab.yaml:3:3: unknown key 'grasp.stanoff' (did you mean "
-                           "'grasp.standoff'?)");
+    EXPECT_STREQ(e.what(),
+                 "lab.yaml:3:3: unknown key 'grasp.stanoff' (did you mean "
+                 "'grasp.standoff'?)");
   }
 }
 

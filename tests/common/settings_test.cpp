@@ -179,8 +179,7 @@ TEST(Settings, HelpShowsTheStructsDefaults) {
             std::string::npos)
       << predictor;
   const std::string c550 = help("sg-c550-sim");
-  EXPECT_NE(c550.find("--delay-max VALUE=" + show(sim::C550Params{}.delay_max)),
-            std::string::npos)
+  EXPECT_NE(c550.find("--delay-max VALUE=" + show(sim::C550Params{}.delay_max)), std::string::npos)
       << c550;
 }
 
