@@ -47,6 +47,115 @@ std::array<double, 3> circle(int64_t u) {
   return {0.5 + 0.15 * std::cos(t * 0.1047), 0.15 * std::sin(t * 0.1047), 0.2};
 }
 
+/// BLOB_LEFT or BLOB_RIGHT: found (search window) while visible, else not found (full frame).
+std::vector<uint8_t> blob(int64_t u, int64_t frame, bool visible, const std::array<double, 3>& x) {
+  stereograsp::blob_t b{};
+  b.utime = u;
+  b.frame_number = frame;
+  b.found = visible;
+  b.mode = visible ? 1 : 2;
+  b.centroid[0] = 320 + 100 * x[0];
+  b.area = 400;
+  return sg::encode_message(b);
+}
+
+/// OBJECT_POSITION (1 mm off the circle, NaN while occluded) or GROUND_TRUTH (always visible).
+std::vector<uint8_t> position(const std::string& channel, int64_t u, bool visible,
+                              const std::array<double, 3>& x) {
+  stereograsp::point3_t p{};
+  p.utime = u;
+  p.visible = channel == "GROUND_TRUTH" || visible;
+  for (int k = 0; k < 3; ++k) p.position[k] = p.visible ? x[k] + 0.001 : NAN;
+  p.reprojection_error = 0.3;
+  return sg::encode_message(p);
+}
+
+/// OBJECT_TRAJECTORY: 16 points of the circle 0.25 s apart, starting one period after u.
+std::vector<uint8_t> trajectory(int64_t u, bool visible) {
+  stereograsp::trajectory_t t{};
+  t.utime = u;
+  t.source_utime = u;
+  t.period_us = 250'000;
+  t.start_utime = u + t.period_us;
+  t.num_points = 16;
+  for (int k = 0; k < 16; ++k) {
+    const auto p = circle(t.start_utime + k * t.period_us);
+    t.position.push_back({p[0], p[1], p[2] + 0.002 * k});
+  }
+  t.status = visible ? 1 : 2;
+  t.model = 1;
+  t.model_order = 12;
+  return sg::encode_message(t);
+}
+
+/// ARM_STATUS: an interaction time between 0.72 and 0.83 s.
+std::vector<uint8_t> arm_status(int64_t u, const std::array<double, 3>& x) {
+  stereograsp::arm_status_t a{};
+  a.utime = u;
+  a.interaction_time = 0.72 + 0.01 * ((u / 800'000) % 12);
+  a.tool_position[0] = x[0];
+  a.speed = 0.5;
+  return sg::encode_message(a);
+}
+
+/// ARM_COMMAND: a Cartesian move to the ball, 40 ms after its source.
+std::vector<uint8_t> arm_command(int64_t u, const std::array<double, 3>& x) {
+  stereograsp::arm_cmd_t c{};
+  c.utime = u;
+  c.source_utime = u - 40'000;
+  c.mode = 1;
+  for (int k = 0; k < 3; ++k) c.position[k] = x[k];
+  c.speed = 0.5;
+  c.sender = "sg-grasp";
+  return sg::encode_message(c);
+}
+
+/// SIM_ARM_STATE: only its time.
+std::vector<uint8_t> sim_arm_state(int64_t u) {
+  stereograsp::sim_arm_state_t s{};
+  s.utime = u;
+  return sg::encode_message(s);
+}
+
+/// GRASP_STATUS: a grasp every 30 s (q0 10 s, q1 5 s, q2 2 s, q3 1 s, q4 and success after).
+std::vector<uint8_t> grasp_status(int64_t u) {
+  stereograsp::grasp_status_t g{};
+  g.utime = u;
+  g.source_utime = u - 30'000;
+  const int64_t phase = (u / 1'000'000) % 30;  // a grasp every 30 s
+  g.state = phase < 10 ? 0 : phase < 15 ? 1 : phase < 17 ? 2 : phase < 18 ? 3 : 4;
+  g.outcome = phase >= 18 ? 1 : 0;
+  g.message = "";
+  for (double& v : g.target) v = NAN;
+  return sg::encode_message(g);
+}
+
+/// The message `channel` carries at time u; `frame` counts the positions written so far.
+std::vector<uint8_t> message_at(const std::string& channel, int64_t u, int64_t frame) {
+  const auto x = circle(u);
+  const bool visible = (u / 1'000'000) % 60 < 57;  // a 3 s occlusion every minute
+  if (channel == "BLOB_LEFT" || channel == "BLOB_RIGHT") return blob(u, frame, visible, x);
+  if (channel == "OBJECT_POSITION" || channel == "GROUND_TRUTH")
+    return position(channel, u, visible, x);
+  if (channel == "OBJECT_TRAJECTORY") return trajectory(u, visible);
+  if (channel == "ARM_STATUS") return arm_status(u, x);
+  if (channel == "ARM_COMMAND") return arm_command(u, x);
+  if (channel == "SIM_ARM_STATE") return sim_arm_state(u);
+  return grasp_status(u);
+}
+
+/// Appends one event, received 3 ms after its message's time u.
+void write_event(lcm::LogFile& log, const std::string& channel, int64_t u,
+                 std::vector<uint8_t>& bytes) {
+  lcm::LogEvent e;
+  e.eventnum = 0;
+  e.timestamp = u + 3000;
+  e.channel = channel;
+  e.datalen = static_cast<int32_t>(bytes.size());
+  e.data = bytes.data();
+  log.writeEvent(&e);
+}
+
 /// Writes `minutes` of session; returns the number of events.
 int64_t write_session(const std::string& path, int minutes) {
   struct Stream {
@@ -65,85 +174,15 @@ int64_t write_session(const std::string& path, int minutes) {
   const int64_t end = kT0 + static_cast<int64_t>(minutes) * 60'000'000;
   lcm::LogFile log(path, "w");
   int64_t events = 0, frame = 0;
-  std::vector<uint8_t> bytes;
   while (!queue.empty()) {
     const auto [u, i] = queue.top();
     queue.pop();
     if (u >= end) continue;
     queue.push({u + streams[i].period_us, i});
     const std::string channel = streams[i].channel;
-    const auto x = circle(u);
-    const bool visible = (u / 1'000'000) % 60 < 57;  // a 3 s occlusion every minute
-    if (channel == "BLOB_LEFT" || channel == "BLOB_RIGHT") {
-      stereograsp::blob_t b{};
-      b.utime = u;
-      b.frame_number = frame;
-      b.found = visible;
-      b.mode = visible ? 1 : 2;
-      b.centroid[0] = 320 + 100 * x[0];
-      b.area = 400;
-      bytes = sg::encode_message(b);
-    } else if (channel == "OBJECT_POSITION" || channel == "GROUND_TRUTH") {
-      stereograsp::point3_t p{};
-      p.utime = u;
-      p.visible = channel == "GROUND_TRUTH" || visible;
-      for (int k = 0; k < 3; ++k) p.position[k] = p.visible ? x[k] + 0.001 : NAN;
-      p.reprojection_error = 0.3;
-      bytes = sg::encode_message(p);
-      if (channel == "OBJECT_POSITION") ++frame;
-    } else if (channel == "OBJECT_TRAJECTORY") {
-      stereograsp::trajectory_t t{};
-      t.utime = u;
-      t.source_utime = u;
-      t.period_us = 250'000;
-      t.start_utime = u + t.period_us;
-      t.num_points = 16;
-      for (int k = 0; k < 16; ++k) {
-        const auto p = circle(t.start_utime + k * t.period_us);
-        t.position.push_back({p[0], p[1], p[2] + 0.002 * k});
-      }
-      t.status = visible ? 1 : 2;
-      t.model = 1;
-      t.model_order = 12;
-      bytes = sg::encode_message(t);
-    } else if (channel == "ARM_STATUS") {
-      stereograsp::arm_status_t a{};
-      a.utime = u;
-      a.interaction_time = 0.72 + 0.01 * ((u / 800'000) % 12);
-      a.tool_position[0] = x[0];
-      a.speed = 0.5;
-      bytes = sg::encode_message(a);
-    } else if (channel == "ARM_COMMAND") {
-      stereograsp::arm_cmd_t c{};
-      c.utime = u;
-      c.source_utime = u - 40'000;
-      c.mode = 1;
-      for (int k = 0; k < 3; ++k) c.position[k] = x[k];
-      c.speed = 0.5;
-      c.sender = "sg-grasp";
-      bytes = sg::encode_message(c);
-    } else if (channel == "SIM_ARM_STATE") {
-      stereograsp::sim_arm_state_t s{};
-      s.utime = u;
-      bytes = sg::encode_message(s);
-    } else {
-      stereograsp::grasp_status_t g{};
-      g.utime = u;
-      g.source_utime = u - 30'000;
-      const int64_t phase = (u / 1'000'000) % 30;  // a grasp every 30 s
-      g.state = phase < 10 ? 0 : phase < 15 ? 1 : phase < 17 ? 2 : phase < 18 ? 3 : 4;
-      g.outcome = phase >= 18 ? 1 : 0;
-      g.message = "";
-      for (double& v : g.target) v = NAN;
-      bytes = sg::encode_message(g);
-    }
-    lcm::LogEvent e;
-    e.eventnum = 0;
-    e.timestamp = u + 3000;
-    e.channel = channel;
-    e.datalen = static_cast<int32_t>(bytes.size());
-    e.data = bytes.data();
-    log.writeEvent(&e);
+    std::vector<uint8_t> bytes = message_at(channel, u, frame);
+    if (channel == "OBJECT_POSITION") ++frame;
+    write_event(log, channel, u, bytes);
     ++events;
   }
   return events;
