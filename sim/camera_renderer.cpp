@@ -61,6 +61,94 @@ Eigen::Vector3d wall(double y, double z) {
   return Eigen::Vector3d(0.76, 0.78, 0.80) * (joint ? 0.75 : 1.0);
 }
 
+/// What the background shows besides the table and the wall: the robot's base and the stickers.
+struct StaticLab {
+  double wall_x = 0.0;
+  Box robot_base;
+  std::vector<Sticker> stickers;
+};
+
+/// Red stickers of 8-14 mm radius, drawn from the seed: even ones on the table (away from the
+/// ball's usual path around (0.45, 0)), odd ones on the wall.
+std::vector<Sticker> place_stickers(const StaticSceneParams& params) {
+  std::mt19937_64 rng(params.seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<Sticker> stickers;
+  for (int i = 0; i < params.distractors; ++i) {
+    const double radius = 0.008 + 0.006 * unit(rng);
+    if (i % 2 == 0) {  // on the table, away from the ball's usual path around (0.45, 0)
+      const double angle = 2 * M_PI * unit(rng), distance = 0.32 + 0.12 * unit(rng);
+      stickers.push_back(
+          {{0.45 + distance * std::cos(angle), distance * std::sin(angle), 0.0}, radius});
+    } else {  // on the wall
+      stickers.push_back({{params.wall_x, -0.6 + 1.2 * unit(rng), 0.1 + 0.5 * unit(rng)}, radius});
+    }
+  }
+  return stickers;
+}
+
+/// The static lab of `params`: the wall's place, a grey 0.18 x 0.18 x 0.30 m robot base at the
+/// origin, and the stickers.
+StaticLab make_static_lab(const StaticSceneParams& params) {
+  StaticLab lab;
+  lab.wall_x = params.wall_x;
+  lab.stickers = place_stickers(params);
+  lab.robot_base.pose.translation() = Eigen::Vector3d(0, 0, 0.15);
+  lab.robot_base.half_size = {0.09, 0.09, 0.15};
+  lab.robot_base.material.albedo = {0.40, 0.40, 0.42};
+  return lab;
+}
+
+/// Colour (BGR, 0-255) of the static lab along the ray from `eye` along `dir`: the nearest of the
+/// table (Z = 0), the wall and the robot's base, a sticker where one lies, dark grey where the ray
+/// hits nothing; lit by an ambient plus a diffuse term.
+Eigen::Vector3d lab_colour(const StaticLab& lab, const Eigen::Vector3d& eye,
+                           const Eigen::Vector3d& to_light, const Eigen::Vector3d& dir) {
+  const Ray ray{eye, dir};
+  double best = std::numeric_limits<double>::infinity();
+  Eigen::Vector3d albedo(0.14, 0.14, 0.14), normal(0, 0, 1);
+  if (dir.z() < 0) {
+    const double t = -eye.z() / dir.z();
+    const Eigen::Vector3d p = eye + t * dir;
+    if (p.x() > lab.wall_x && p.x() < 4.0 && std::abs(p.y()) < 4.0) {
+      best = t, albedo = wood(p.x(), p.y()), normal = {0, 0, 1};
+    }
+  }
+  if (dir.x() < 0) {
+    const double t = (lab.wall_x - eye.x()) / dir.x();
+    const Eigen::Vector3d p = eye + t * dir;
+    if (t < best && p.z() > 0) best = t, albedo = wall(p.y(), p.z()), normal = {1, 0, 0};
+  }
+  if (auto t = lab.robot_base.intersect(ray); t && *t < best) {
+    best = *t;
+    albedo = lab.robot_base.material.albedo;
+    normal = lab.robot_base.normal_at(eye + *t * dir);
+  }
+  if (std::isfinite(best)) {
+    const Eigen::Vector3d p = eye + best * dir;
+    for (const Sticker& s : lab.stickers) {
+      if ((p - s.centre).norm() < s.radius) albedo = kRedAlbedo;
+    }
+  }
+  return albedo * (0.55 + 0.45 * std::max(0.0, normal.dot(to_light))) * 255.0;
+}
+
+/// Merges screen regions that overlap, until none do; a merged region holds the ball if either
+/// did. Each pixel is then ray-cast once.
+void merge_overlapping(std::vector<std::pair<cv::Rect, bool>>& regions) {
+  for (bool merged = true; merged;) {
+    merged = false;
+    for (size_t i = 0; i < regions.size() && !merged; ++i) {
+      for (size_t j = i + 1; j < regions.size() && !merged; ++j) {
+        if ((regions[i].first & regions[j].first).empty()) continue;
+        regions[i] = {regions[i].first | regions[j].first, regions[i].second || regions[j].second};
+        regions.erase(regions.begin() + static_cast<std::ptrdiff_t>(j));
+        merged = true;
+      }
+    }
+  }
+}
+
 }  // namespace
 
 struct CameraRenderer::Objects {
@@ -116,63 +204,17 @@ CameraRenderer::CameraRenderer(const vision::CameraModel& camera, const StaticSc
 }
 
 void CameraRenderer::render_background(const StaticSceneParams& params) {
-  std::mt19937_64 rng(params.seed);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::vector<Sticker> stickers;
-  for (int i = 0; i < params.distractors; ++i) {
-    const double radius = 0.008 + 0.006 * unit(rng);
-    if (i % 2 == 0) {  // on the table, away from the ball's usual path around (0.45, 0)
-      const double angle = 2 * M_PI * unit(rng), distance = 0.32 + 0.12 * unit(rng);
-      stickers.push_back(
-          {{0.45 + distance * std::cos(angle), distance * std::sin(angle), 0.0}, radius});
-    } else {  // on the wall
-      stickers.push_back({{params.wall_x, -0.6 + 1.2 * unit(rng), 0.1 + 0.5 * unit(rng)}, radius});
-    }
-  }
-  Box robot_base;
-  robot_base.pose.translation() = Eigen::Vector3d(0, 0, 0.15);
-  robot_base.half_size = {0.09, 0.09, 0.15};
-  robot_base.material.albedo = {0.40, 0.40, 0.42};
-
-  auto sample = [&](const Eigen::Vector3d& dir) -> Eigen::Vector3d {
-    const Ray ray{eye_, dir};
-    double best = std::numeric_limits<double>::infinity();
-    Eigen::Vector3d albedo(0.14, 0.14, 0.14), normal(0, 0, 1);
-    if (dir.z() < 0) {
-      const double t = -eye_.z() / dir.z();
-      const Eigen::Vector3d p = eye_ + t * dir;
-      if (p.x() > params.wall_x && p.x() < 4.0 && std::abs(p.y()) < 4.0) {
-        best = t, albedo = wood(p.x(), p.y()), normal = {0, 0, 1};
-      }
-    }
-    if (dir.x() < 0) {
-      const double t = (params.wall_x - eye_.x()) / dir.x();
-      const Eigen::Vector3d p = eye_ + t * dir;
-      if (t < best && p.z() > 0) best = t, albedo = wall(p.y(), p.z()), normal = {1, 0, 0};
-    }
-    if (auto t = robot_base.intersect(ray); t && *t < best) {
-      best = *t;
-      albedo = robot_base.material.albedo;
-      normal = robot_base.normal_at(eye_ + *t * dir);
-    }
-    if (std::isfinite(best)) {
-      const Eigen::Vector3d p = eye_ + best * dir;
-      for (const Sticker& s : stickers) {
-        if ((p - s.centre).norm() < s.radius) albedo = kRedAlbedo;
-      }
-    }
-    return albedo * (0.55 + 0.45 * std::max(0.0, normal.dot(to_light_))) * 255.0;
-  };
-
+  const StaticLab lab = make_static_lab(params);
   const int w = camera_.width(), h = camera_.height();
   background_.create(h, w, CV_8UC3);
   for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
+    for (int x = 0; x < w; ++x) {  // 2 x 2 rays a pixel
       const auto &a = corner_ray(x, y), &b = corner_ray(x + 1, y), &c = corner_ray(x, y + 1),
                  &d = corner_ray(x + 1, y + 1);
       Eigen::Vector3d sum = Eigen::Vector3d::Zero();
       for (double v : {0.25, 0.75}) {
-        for (double u : {0.25, 0.75}) sum += sample(blend(a, b, c, d, u, v));
+        for (double u : {0.25, 0.75})
+          sum += lab_colour(lab, eye_, to_light_, blend(a, b, c, d, u, v));
       }
       background_.at<cv::Vec3b>(y, x) = to_pixel(sum / 4);
     }
@@ -295,16 +337,15 @@ void CameraRenderer::apply_exposure(const DynamicScene& scene, cv::Mat& image) c
   cv::subtract(image, noise_down_[k], image);
 }
 
-BallVisibility CameraRenderer::render(const DynamicScene& scene, cv::Mat& image) const {
-  background_.copyTo(image);
-  Objects objects;
-  objects.boxes = &scene.boxes;
-  BallVisibility seen;
+struct CameraRenderer::BallImage {
+  cv::Rect region;             // where the ball was drawn
+  cv::Mat coverage;            // CV_32F over `region`: the fraction of each pixel on the ball
+  double silhouette_px = 0.0;  // the ball's area, pixels
+};
 
-  // Screen regions to ray-cast: the ball's, and the gripper's merged with it where they overlap
-  // (every pixel once; each region is drawn against all objects, so overlaps would agree anyway).
+std::vector<std::pair<cv::Rect, bool>> CameraRenderer::screen_regions(
+    const DynamicScene& scene, Objects& objects, std::vector<cv::Rect>& ball_screens) const {
   std::vector<std::pair<cv::Rect, bool>> regions;  // (region, holds the ball)
-  std::vector<cv::Rect> ball_screens;
   for (const Eigen::Vector3d& c : scene.ball_centres) {
     if (auto box = screen_box(sphere_cube(c, scene.ball_radius))) {
       regions.emplace_back(*box, true);
@@ -321,56 +362,68 @@ BallVisibility CameraRenderer::render(const DynamicScene& scene, cv::Mat& image)
       objects.screen[i + 1] = *r;
     }
   }
-  for (bool merged = true; merged;) {
-    merged = false;
-    for (size_t i = 0; i < regions.size() && !merged; ++i) {
-      for (size_t j = i + 1; j < regions.size() && !merged; ++j) {
-        if ((regions[i].first & regions[j].first).empty()) continue;
-        regions[i] = {regions[i].first | regions[j].first, regions[i].second || regions[j].second};
-        regions.erase(regions.begin() + static_cast<std::ptrdiff_t>(j));
-        merged = true;
-      }
-    }
-  }
+  return regions;
+}
 
-  cv::Rect ball_region;
-  cv::Mat ball_coverage;
-  if (scene.ball_centres.size() <= 1) {  // sharp: every region drawn once, idempotently
-    objects.has_ball = !scene.ball_centres.empty();
-    if (objects.has_ball) {
-      objects.ball = {scene.ball_centres.front(), scene.ball_radius, scene.ball_material};
-      objects.screen[0] = ball_screens.front();
-    }
-    for (const auto& [region, is_ball] : regions) {
-      if (is_ball) {
-        ball_region = region;
-        ball_coverage = cv::Mat::zeros(region.size(), CV_32F);
-        seen.silhouette_px = render_region(objects, region, image, &ball_coverage);
-      } else {
-        render_region(objects, region, image, nullptr);
-      }
-    }
-  } else {  // motion blur: the union of the ball's positions, averaged over the exposure
-    cv::Rect all;
-    for (const auto& [region, is_ball] : regions) all = all.empty() ? region : (all | region);
-    cv::Mat sum = cv::Mat::zeros(all.size(), CV_32FC3);
-    ball_coverage = cv::Mat::zeros(all.size(), CV_32F);
-    for (size_t s = 0; s < scene.ball_centres.size(); ++s) {
-      objects.has_ball = true;
-      objects.ball = {scene.ball_centres[s], scene.ball_radius, scene.ball_material};
-      objects.screen[0] = ball_screens[s];
-      cv::Mat pass = image.clone(), coverage = cv::Mat::zeros(all.size(), CV_32F);
-      seen.silhouette_px += render_region(objects, all, pass, &coverage);
-      cv::accumulate(pass(all), sum);
-      ball_coverage += coverage;
-    }
-    const double n = static_cast<double>(scene.ball_centres.size());
-    sum.convertTo(image(all), CV_8UC3, 1.0 / n);
-    ball_coverage /= n;
-    seen.silhouette_px /= n;
-    ball_region = all;
+CameraRenderer::BallImage CameraRenderer::render_sharp(
+    const DynamicScene& scene, const std::vector<std::pair<cv::Rect, bool>>& regions,
+    const std::vector<cv::Rect>& ball_screens, Objects& objects, cv::Mat& image) const {
+  BallImage ball;
+  objects.has_ball = !scene.ball_centres.empty();
+  if (objects.has_ball) {
+    objects.ball = {scene.ball_centres.front(), scene.ball_radius, scene.ball_material};
+    objects.screen[0] = ball_screens.front();
   }
-  seen.visible_px = seen.silhouette_px - hidden_by_panel(scene, ball_region, ball_coverage, image);
+  for (const auto& [region, is_ball] : regions) {
+    if (is_ball) {
+      ball.region = region;
+      ball.coverage = cv::Mat::zeros(region.size(), CV_32F);
+      ball.silhouette_px = render_region(objects, region, image, &ball.coverage);
+    } else {
+      render_region(objects, region, image, nullptr);
+    }
+  }
+  return ball;
+}
+
+CameraRenderer::BallImage CameraRenderer::render_blurred(
+    const DynamicScene& scene, const std::vector<std::pair<cv::Rect, bool>>& regions,
+    const std::vector<cv::Rect>& ball_screens, Objects& objects, cv::Mat& image) const {
+  BallImage ball;
+  cv::Rect all;
+  for (const auto& [region, is_ball] : regions) all = all.empty() ? region : (all | region);
+  cv::Mat sum = cv::Mat::zeros(all.size(), CV_32FC3);
+  ball.coverage = cv::Mat::zeros(all.size(), CV_32F);
+  for (size_t s = 0; s < scene.ball_centres.size(); ++s) {
+    objects.has_ball = true;
+    objects.ball = {scene.ball_centres[s], scene.ball_radius, scene.ball_material};
+    objects.screen[0] = ball_screens[s];
+    cv::Mat pass = image.clone(), coverage = cv::Mat::zeros(all.size(), CV_32F);
+    ball.silhouette_px += render_region(objects, all, pass, &coverage);
+    cv::accumulate(pass(all), sum);
+    ball.coverage += coverage;
+  }
+  const double n = static_cast<double>(scene.ball_centres.size());
+  sum.convertTo(image(all), CV_8UC3, 1.0 / n);
+  ball.coverage /= n;
+  ball.silhouette_px /= n;
+  ball.region = all;
+  return ball;
+}
+
+BallVisibility CameraRenderer::render(const DynamicScene& scene, cv::Mat& image) const {
+  background_.copyTo(image);
+  Objects objects;
+  objects.boxes = &scene.boxes;
+  std::vector<cv::Rect> ball_screens;  // per ball centre; empty where it is not drawn
+  std::vector<std::pair<cv::Rect, bool>> regions = screen_regions(scene, objects, ball_screens);
+  merge_overlapping(regions);
+  const BallImage ball = scene.ball_centres.size() <= 1
+                             ? render_sharp(scene, regions, ball_screens, objects, image)
+                             : render_blurred(scene, regions, ball_screens, objects, image);
+  BallVisibility seen;
+  seen.silhouette_px = ball.silhouette_px;
+  seen.visible_px = seen.silhouette_px - hidden_by_panel(scene, ball.region, ball.coverage, image);
   apply_exposure(scene, image);
   return seen;
 }

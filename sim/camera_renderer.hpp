@@ -84,6 +84,23 @@ class CameraRenderer {
   double hidden_by_panel(const DynamicScene& scene, const cv::Rect& region,
                          const cv::Mat& ball_coverage, cv::Mat& image) const;
   void apply_exposure(const DynamicScene& scene, cv::Mat& image) const;
+  /// The screen regions to ray-cast, (region, holds the ball): one per drawn ball centre (also
+  /// kept in `ball_screens`, an empty one where a centre is not drawn) and one per box (also kept
+  /// in objects.screen).
+  std::vector<std::pair<cv::Rect, bool>> screen_regions(const DynamicScene& scene, Objects& objects,
+                                                        std::vector<cv::Rect>& ball_screens) const;
+  /// What render_sharp and render_blurred drew of the ball.
+  struct BallImage;
+  /// A sharp ball (at most one centre): every region drawn once, into `image`.
+  BallImage render_sharp(const DynamicScene& scene,
+                         const std::vector<std::pair<cv::Rect, bool>>& regions,
+                         const std::vector<cv::Rect>& ball_screens, Objects& objects,
+                         cv::Mat& image) const;
+  /// Motion blur: the union of the regions drawn once per ball centre and averaged (the exposure).
+  BallImage render_blurred(const DynamicScene& scene,
+                           const std::vector<std::pair<cv::Rect, bool>>& regions,
+                           const std::vector<cv::Rect>& ball_screens, Objects& objects,
+                           cv::Mat& image) const;
 
   vision::CameraModel camera_;
   Eigen::Vector3d eye_;
