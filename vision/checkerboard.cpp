@@ -50,12 +50,9 @@ CameraModel to_camera(const cv::Mat& K, const cv::Mat& D, const cv::Mat& R, cons
       t_e);
 }
 
-}  // namespace
-
-CheckerboardResult calibrate_checkerboard(const std::vector<std::string>& left,
-                                          const std::vector<std::string>& right,
-                                          const CheckerboardParams& p,
-                                          const std::function<void(const std::string&)>& progress) {
+/// Throws unless the lists pair up and the pattern has at least 2x2 inner corners and a square.
+void check_inputs(const std::vector<std::string>& left, const std::vector<std::string>& right,
+                  const CheckerboardParams& p) {
   if (left.size() != right.size()) {
     throw CalibrationInputError(std::to_string(left.size()) + " left images but " +
                                 std::to_string(right.size()) + " right images");
@@ -63,65 +60,112 @@ CheckerboardResult calibrate_checkerboard(const std::vector<std::string>& left,
   if (p.pattern.width < 2 || p.pattern.height < 2 || !(p.square > 0))
     throw CalibrationInputError(
         "the pattern needs at least 2x2 inner corners and a positive square");
+}
+
+/// The board's inner corners in its own plane (Z = 0), row by row, metres.
+std::vector<cv::Point3f> board_points(const CheckerboardParams& p) {
   std::vector<cv::Point3f> board;
   for (int y = 0; y < p.pattern.height; ++y) {
     for (int x = 0; x < p.pattern.width; ++x) {
       board.emplace_back(static_cast<float>(x * p.square), static_cast<float>(y * p.square), 0.0f);
     }
   }
-  CheckerboardResult result;
-  cv::Size size;
-  std::vector<std::vector<cv::Point2f>> corners[2];
-  std::vector<size_t> used;
+  return board;
+}
+
+/// The corners found in the stereo views where both images show the board.
+struct Detections {
+  cv::Size size;                                     ///< the images' size
+  std::vector<std::vector<cv::Point2f>> corners[2];  ///< per camera, per used view
+  std::vector<size_t> used;                          ///< the used views' indices in `views`
+};
+
+/// Why a view was dropped, from which of its images lacked the board.
+std::string dropped_because(bool found_left, bool found_right) {
+  const char* which = !found_left && !found_right ? "left and right images"
+                      : !found_left               ? "left image"
+                                                  : "right image";
+  return std::string("board not found in the ") + which;
+}
+
+/// Looks for the board in every stereo view (calling `progress` with each image's name); a view
+/// report per pair goes to `views`.
+Detections find_boards(const std::vector<std::string>& left, const std::vector<std::string>& right,
+                       const CheckerboardParams& p,
+                       const std::function<void(const std::string&)>& progress,
+                       std::vector<ViewReport>& views) {
+  Detections d;
   for (size_t i = 0; i < left.size(); ++i) {
     ViewReport view;
     view.left = left[i];
     view.right = right[i];
     std::vector<cv::Point2f> l, r;
     if (progress) progress(left[i]);
-    const bool found_left = find_corners(left[i], p, size, l);
+    const bool found_left = find_corners(left[i], p, d.size, l);
     if (progress) progress(right[i]);
-    const bool found_right = find_corners(right[i], p, size, r);
+    const bool found_right = find_corners(right[i], p, d.size, r);
     if (found_left && found_right) {
       view.used = true;
-      corners[0].push_back(l);
-      corners[1].push_back(r);
-      used.push_back(result.views.size());
+      d.corners[0].push_back(l);
+      d.corners[1].push_back(r);
+      d.used.push_back(views.size());
     } else {
-      view.dropped_because = std::string("board not found in the ") +
-                             (!found_left && !found_right ? "left and right images"
-                              : !found_left               ? "left image"
-                                                          : "right image");
+      view.dropped_because = dropped_because(found_left, found_right);
     }
-    result.views.push_back(view);
+    views.push_back(view);
   }
-  if (corners[0].size() < 3) {
+  return d;
+}
+
+/// Throws unless the board was found in at least 3 stereo views.
+void require_three_views(const CheckerboardParams& p, size_t found) {
+  if (found < 3) {
     throw CalibrationInputError("the " + std::to_string(p.pattern.width) + "x" +
                                 std::to_string(p.pattern.height) + " board was found in " +
-                                std::to_string(corners[0].size()) +
+                                std::to_string(found) +
                                 " stereo pairs; at least 3 are needed (wrong --pattern?)");
   }
-  const std::vector<std::vector<cv::Point3f>> boards(corners[0].size(), board);
+}
+
+/// Each camera's own calibration (K, D with k3 fixed at 0) from the used views; returns its RMS
+/// reprojection error and writes each view's into `views`.
+double calibrate_one(int c, const std::vector<cv::Point3f>& board,
+                     const std::vector<std::vector<cv::Point3f>>& boards, const Detections& d,
+                     cv::Mat& K, cv::Mat& D, std::vector<ViewReport>& views) {
+  std::vector<cv::Mat> rvecs, tvecs;
+  const double rms =
+      cv::calibrateCamera(boards, d.corners[c], d.size, K, D, rvecs, tvecs, cv::CALIB_FIX_K3);
+  for (size_t v = 0; v < d.used.size(); ++v) {
+    const double e = view_rms(board, d.corners[c][v], rvecs[v], tvecs[v], K, D);
+    (c == 0 ? views[d.used[v]].rms_left : views[d.used[v]].rms_right) = e;
+  }
+  return rms;
+}
+
+}  // namespace
+
+CheckerboardResult calibrate_checkerboard(const std::vector<std::string>& left,
+                                          const std::vector<std::string>& right,
+                                          const CheckerboardParams& p,
+                                          const std::function<void(const std::string&)>& progress) {
+  check_inputs(left, right, p);
+  const std::vector<cv::Point3f> board = board_points(p);
+  CheckerboardResult result;
+  const Detections d = find_boards(left, right, p, progress, result.views);
+  require_three_views(p, d.corners[0].size());
+  const std::vector<std::vector<cv::Point3f>> boards(d.corners[0].size(), board);
   cv::Mat K[2], D[2];
   double rms[2];
-  for (int c = 0; c < 2; ++c) {
-    std::vector<cv::Mat> rvecs, tvecs;
-    rms[c] =
-        cv::calibrateCamera(boards, corners[c], size, K[c], D[c], rvecs, tvecs, cv::CALIB_FIX_K3);
-    for (size_t v = 0; v < used.size(); ++v) {
-      const double e = view_rms(board, corners[c][v], rvecs[v], tvecs[v], K[c], D[c]);
-      (c == 0 ? result.views[used[v]].rms_left : result.views[used[v]].rms_right) = e;
-    }
-  }
+  for (int c = 0; c < 2; ++c) rms[c] = calibrate_one(c, board, boards, d, K[c], D[c], result.views);
   cv::Mat R, T, E, F;
-  result.rms_stereo = cv::stereoCalibrate(boards, corners[0], corners[1], K[0], D[0], K[1], D[1],
-                                          size, R, T, E, F, cv::CALIB_FIX_INTRINSIC);
+  result.rms_stereo = cv::stereoCalibrate(boards, d.corners[0], d.corners[1], K[0], D[0], K[1],
+                                          D[1], d.size, R, T, E, F, cv::CALIB_FIX_INTRINSIC);
   StereoCalibration& s = result.calibration;
-  s.left = to_camera(K[0], D[0], cv::Mat::eye(3, 3, CV_64F), cv::Mat::zeros(3, 1, CV_64F), size);
-  s.right = to_camera(K[1], D[1], R, T, size);
+  s.left = to_camera(K[0], D[0], cv::Mat::eye(3, 3, CV_64F), cv::Mat::zeros(3, 1, CV_64F), d.size);
+  s.right = to_camera(K[1], D[1], R, T, d.size);
   s.rms_left = rms[0];
   s.rms_right = rms[1];
-  s.source = "sg-calibrate checkerboard (" + std::to_string(corners[0].size()) + " stereo views)";
+  s.source = "sg-calibrate checkerboard (" + std::to_string(d.corners[0].size()) + " stereo views)";
   return result;
 }
 
