@@ -25,6 +25,7 @@
 #include "sim/c550_controller.hpp"
 #include "sim/c550_emulator.hpp"
 #include "tests/support/arm_commands.hpp"
+#include "tests/support/wait.hpp"
 
 namespace sg::arm {
 namespace {
@@ -267,17 +268,11 @@ class ArmDriverTest : public testing::Test {
   /// Waits up to kPatience for the status to satisfy `condition`.
   testing::AssertionResult eventually(const std::function<bool(const Status&)>& condition,
                                       const char* what) {
-    const auto give_up = Clock::now() + kPatience;
-    Status s = driver_->status().first;
-    while (!condition(s)) {
-      if (Clock::now() > give_up) {
-        return testing::AssertionFailure()
-               << "no status with " << what << "; last: " << describe(s);
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-      s = driver_->status().first;
+    if (sg::test::wait_until([&] { return condition(driver_->status().first); }, kPatience)) {
+      return testing::AssertionSuccess();
     }
-    return testing::AssertionSuccess();
+    return testing::AssertionFailure()
+           << "no status with " << what << "; last: " << describe(driver_->status().first);
   }
   testing::AssertionResult connected() {
     return eventually([](const Status& s) { return s.state == Status::STATE_IDLE; }, "IDLE");
@@ -428,6 +423,7 @@ TEST_F(ArmDriverTest, ReconnectsAfterLinkDownAndExecutesPendingCommandOnce) {
                          "DISCONNECTED"));
   EXPECT_NE(status().error, "");
   driver_->submit(command);
+  // A window, not a wait: the command is held through half a second of the outage.
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   EXPECT_EQ(status().state, Status::STATE_DISCONNECTED);
   EXPECT_EQ(status().last_executed_sequence, -1);

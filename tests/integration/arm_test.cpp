@@ -17,6 +17,7 @@
 #include "tests/integration/multicast_guard.hpp"
 #include "tests/support/arm_commands.hpp"
 #include "tests/support/subprocess.hpp"
+#include "tests/support/wait.hpp"
 
 namespace sg::test {
 namespace {
@@ -104,8 +105,8 @@ class ArmRig {
                                     "100"};
     sim.insert(sim.end(), sim_flags.begin(), sim_flags.end());
     sim_ = std::make_unique<Child>(sim);
-    for (int i = 0; i < 100 && !std::filesystem::exists(device()); ++i)
-      std::this_thread::sleep_for(50ms);
+    EXPECT_TRUE(eventually([&] { return std::filesystem::exists(device()); }, 30s,
+                           "sg-c550-sim's pseudo-terminal at " + device()));
     driver_ = std::make_unique<Child>(std::vector<std::string>{
         program("sg-arm-driver"), "--lcm-url", url_, "--device", device()});
   }
@@ -204,6 +205,7 @@ TEST(ArmProcesses, MoveGripperCycleAndRejection) {
   // A stale sequence number is refused too.
   rig.bus().publish("ARM_COMMAND", move_to(2, 0.40, 0.0, 0.40));
   ASSERT_TRUE(rig.wait_until([&] { return rig.status().last_rejected_sequence == 2; }, 10s));
+  // A window, not a wait: no MA may reach the controller in the second after the refusals.
   std::this_thread::sleep_for(1s);
   EXPECT_EQ(starting_with(logged_commands(rig.command_log()), "MA").size(), before);
 }
@@ -217,7 +219,7 @@ TEST(ArmProcesses, LatestWinsUnderABurst) {
   for (int i = 1; i <= 100; ++i) {
     const double a = 0.01 * i;
     rig.bus().publish("ARM_COMMAND", move_to(i, 0.50 * std::cos(a), 0.50 * std::sin(a), 0.30));
-    std::this_thread::sleep_for(2ms);
+    std::this_thread::sleep_for(2ms);  // pacing: the burst (100 in 0.2 s) is what is under test
   }
   ASSERT_TRUE(rig.wait_executed(100, 30s)) << rig.status().error;
   EXPECT_LT(tool_error(rig.status(), 0.50 * std::cos(1.0), 0.50 * std::sin(1.0), 0.30), 1e-3);
@@ -240,7 +242,7 @@ TEST(ArmProcesses, RecoversAfterADisconnect) {
     const double a = 0.2 * static_cast<double>(sequence);
     rig.bus().publish("ARM_COMMAND",
                       move_to(sequence, 0.50 * std::cos(a), 0.50 * std::sin(a), 0.35));
-    rig.wait_until([] { return false; }, 1s);
+    handle_for(rig.bus(), 1s);  // pacing: one command a second, across the line's outage
   }
   ASSERT_TRUE(rig.wait_executed(sequence, 30s)) << rig.status().error;
   EXPECT_TRUE(rig.saw_disconnected());

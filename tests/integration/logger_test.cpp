@@ -7,11 +7,12 @@
 #include <filesystem>
 #include <fstream>
 #include <lcm/lcm-cpp.hpp>
-#include <thread>
 
+#include "common/bus.hpp"
 #include "common/bus_check.hpp"
 #include "tests/integration/multicast_guard.hpp"
 #include "tests/support/subprocess.hpp"
+#include "tests/support/wait.hpp"
 
 namespace sg::test {
 namespace {
@@ -28,13 +29,21 @@ class LoggerTest : public ::testing::Test {
     dir_ = make_temp_dir();
     log_path_ = dir_ + "/session.lcmlog";
     Child logger({SG_LCM_LOGGER, "--lcm-url=" + test_url(7902), "-c", "BUS_CHECK_.*", log_path_});
-    std::this_thread::sleep_for(1s);  // let the logger join the group
-    const ProcessResult sender =
-        run({program("sg-bus-check"), "send", "--count", std::to_string(kCount), "--rate", "200",
-             "--lcm-url", test_url(7902)},
-            60s);
+    ASSERT_TRUE(eventually([&] { return joined_bus(logger.pid(), 7902); }, 30s,
+                           "lcm-logger to join the bus"));
+    Bus observer(test_url(7902));  // hears what the logger hears
+    int heard = 0;
+    observer.subscribe_raw("BUS_CHECK_.*", [&](const RawMessage&) { ++heard; });
+    Child sending({program("sg-bus-check"), "send", "--count", std::to_string(kCount), "--rate",
+                   "200", "--lcm-url", test_url(7902)});
+    wait_until(
+        observer, [&] { return !sending.running(); }, 60s);  // reading what it sends
+    const ProcessResult sender = sending.wait(1s);
     ASSERT_EQ(sender.exit_code, 0) << sender.err;
-    std::this_thread::sleep_for(300ms);
+    // Stop lcm-logger once every message has reached it and it has read them all.
+    ASSERT_TRUE(eventually(
+        observer, [&] { return heard >= kCount && drained_bus(logger.pid(), 7902); }, 30s,
+        "lcm-logger to read all " + std::to_string(kCount) + " messages"));
     logger.signal(SIGINT);
     const ProcessResult stopped = logger.wait(10s);
     ASSERT_FALSE(stopped.timed_out) << "lcm-logger did not stop on SIGINT";
@@ -91,7 +100,8 @@ TEST_F(LoggerTest, LogplayerReplaysToASubscriber) {
   ASSERT_TRUE(multicast_available(7903));
   Child receiver({program("sg-bus-check"), "receive", "--count", std::to_string(kCount),
                   "--timeout", "10", "--lcm-url", test_url(7903)});
-  std::this_thread::sleep_for(1s);
+  ASSERT_TRUE(eventually([&] { return joined_bus(receiver.pid(), 7903); }, 30s,
+                         "the receiver to join the bus"));
   const ProcessResult player =
       run({SG_LCM_LOGPLAYER, "-s", "4", "-l", test_url(7903), log_path_}, 60s);
   EXPECT_EQ(player.exit_code, 0) << player.err;

@@ -12,6 +12,7 @@
 #include "sim/scenario.hpp"
 #include "tests/integration/multicast_guard.hpp"
 #include "tests/support/subprocess.hpp"
+#include "tests/support/wait.hpp"
 
 namespace sg::test {
 namespace {
@@ -46,7 +47,9 @@ TEST(Predictor, ReplayedLogGivesIdenticalTrajectories) {
   const std::string log = dir + "/session.lcmlog";
   Child live({program("sg-predictor"), "--lcm-url", test_url(7914)});
   Child logger({SG_LCM_LOGGER, "--lcm-url=" + test_url(7914), "-c", "OBJECT_POSITION", log});
-  std::this_thread::sleep_for(1s);
+  ASSERT_TRUE(
+      eventually([&] { return joined_bus(live.pid(), 7914) && joined_bus(logger.pid(), 7914); },
+                 30s, "sg-predictor and lcm-logger to join the bus"));
 
   sim::ScenarioParams sp;
   sp.phase = 0.3;
@@ -80,7 +83,8 @@ TEST(Predictor, ReplayedLogGivesIdenticalTrajectories) {
   ASSERT_EQ(live_out.size(), static_cast<size_t>(kSamples));
 
   Child replayed({program("sg-predictor"), "--lcm-url", test_url(7915)});
-  std::this_thread::sleep_for(1s);
+  ASSERT_TRUE(eventually([&] { return joined_bus(replayed.pid(), 7915); }, 30s,
+                         "the replayed sg-predictor to join the bus"));
   Bus b(test_url(7915));
   listen(b, replay_out);
   Child player({SG_LCM_LOGPLAYER, "-s", "1", "-l", test_url(7915), log});  // at recorded speed

@@ -12,12 +12,12 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <thread>
 
 #include "arm_driver/kinematics.hpp"
 #include "common/config.hpp"
 #include "tests/integration/multicast_guard.hpp"
 #include "tests/support/subprocess.hpp"
+#include "tests/support/wait.hpp"
 #include "vision/calibration_file.hpp"
 #include "vision/triangulation.hpp"
 
@@ -84,9 +84,8 @@ TEST(RobotCalibrationProcesses, CalibratesTheSimulatedCamerasInTheRobotFrame) {
   const std::string url = test_url(kPort);
   const std::string device = dir + "/c550";
   Child sim({program("sg-c550-sim"), "--lcm-url", url, "--link", device, "--holding"});
-  for (int i = 0; i < 100 && !std::filesystem::exists(device); ++i)
-    std::this_thread::sleep_for(50ms);
-  ASSERT_TRUE(std::filesystem::exists(device));
+  ASSERT_TRUE(eventually([&] { return std::filesystem::exists(device); }, 30s,
+                         "sg-c550-sim's pseudo-terminal at " + device));
   Child driver({program("sg-arm-driver"), "--lcm-url", url, "--device", device});
   Child cameras(
       {program("sg-camera-sim"), "--lcm-url", url, "--calibration-out", dir + "/truth.yaml"});

@@ -2,10 +2,9 @@
 
 #include <gtest/gtest.h>
 
-#include <thread>
-
 #include "tests/integration/multicast_guard.hpp"
 #include "tests/support/subprocess.hpp"
+#include "tests/support/wait.hpp"
 
 namespace sg::test {
 namespace {
@@ -19,7 +18,8 @@ TEST(Udpm, ThousandMessagesAt100HzBetweenProcessesNoneLost) {
   const std::string url = test_url(kPort);
   Child receiver(
       {program("sg-bus-check"), "receive", "--count", "1000", "--timeout", "10", "--lcm-url", url});
-  std::this_thread::sleep_for(1s);  // let the receiver join the group
+  ASSERT_TRUE(eventually([&] { return joined_bus(receiver.pid(), kPort); }, 30s,
+                         "the receiver to join the bus"));
   const ProcessResult sender = run(
       {program("sg-bus-check"), "send", "--count", "1000", "--rate", "100", "--lcm-url", url}, 60s);
   ASSERT_EQ(sender.exit_code, 0) << sender.err;

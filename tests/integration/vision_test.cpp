@@ -8,12 +8,12 @@
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
-#include <thread>
 
 #include "common/bus.hpp"
 #include "common/message_types.hpp"
 #include "tests/integration/multicast_guard.hpp"
 #include "tests/support/subprocess.hpp"
+#include "tests/support/wait.hpp"
 #include "vision/image_message.hpp"
 
 namespace sg::test {
@@ -43,7 +43,8 @@ TEST(Vision, PositionsFromSimulatedCamerasMatchTheTruth) {
                                      [&](const auto& m, const auto&) { blobs += m.found; });
   Child vision({program("sg-vision"), "--calibration", dir + "/cams.yaml", "--frames", "30",
                 "--lcm-url", url});
-  std::this_thread::sleep_for(1s);
+  ASSERT_TRUE(eventually([&] { return joined_bus(vision.pid(), kPort); }, 30s,
+                         "sg-vision to join the bus"));
   // A malformed image first: 640x480 BGR that holds 100 bytes.
   stereograsp::image_t bad{};
   bad.width = 640, bad.height = 480, bad.row_stride = 1920;
@@ -130,7 +131,9 @@ TEST(Viewer, RecordedViewShowsTheSearchWindowWhereTheBlobWas) {
   Child viewer({program("sg-viewer"), "--record", dir + "/view.avi", "--frames", "15",
                 "--no-window", "--lcm-url", url});
   Child vision({program("sg-vision"), "--frames", "20", "--lcm-url", url});
-  std::this_thread::sleep_for(1s);
+  ASSERT_TRUE(
+      eventually([&] { return joined_bus(viewer.pid(), kPort) && joined_bus(vision.pid(), kPort); },
+                 30s, "sg-viewer and sg-vision to join the bus"));
   Child sim({program("sg-camera-sim"), "--rate", "10", "--frames", "20", "--lcm-url", url});
   const auto deadline = std::chrono::steady_clock::now() + 60s;
   while (windows.size() < 20 && std::chrono::steady_clock::now() < deadline) bus.handle(100ms);

@@ -5,19 +5,20 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <lcm/lcm-cpp.hpp>
 #include <nlohmann/json.hpp>
 #include <sstream>
-#include <thread>
 
 #include "common/bus.hpp"
 #include "common/clock.hpp"
 #include "common/message_types.hpp"
 #include "tests/integration/multicast_guard.hpp"
 #include "tests/support/subprocess.hpp"
+#include "tests/support/wait.hpp"
 
 namespace sg::test {
 namespace {
@@ -220,9 +221,19 @@ TEST(ReportLive, RecordedSessionFromTheRealPredictor) {
   const std::string log = dir + "/live.lcmlog";
   Child predictor({program("sg-predictor"), "--lcm-url", test_url(7922)});
   Child logger({SG_LCM_LOGGER, "--lcm-url=" + test_url(7922), log});
-  std::this_thread::sleep_for(1s);
+  ASSERT_TRUE(eventually(
+      [&] { return joined_bus(predictor.pid(), 7922) && joined_bus(logger.pid(), 7922); }, 30s,
+      "sg-predictor and lcm-logger to join the bus"));
 
   Bus bus(test_url(7922));
+  int64_t newest_source = 0;  // the newest forecast's measurement time
+  int positions_heard = 0, forecasts_heard = 0;
+  bus.subscribe<stereograsp::trajectory_t>(
+      "OBJECT_TRAJECTORY", [&](const stereograsp::trajectory_t& t, const ReceiveInfo&) {
+        newest_source = std::max(newest_source, t.source_utime);
+        ++forecasts_heard;
+      });
+  bus.subscribe_raw("OBJECT_POSITION", [&](const RawMessage&) { ++positions_heard; });
   constexpr int kSent = 150;  // 5 s at 30 Hz, real time
   const int64_t start = now_utime();
   for (int k = 0; k < kSent; ++k) {
@@ -234,19 +245,32 @@ TEST(ReportLive, RecordedSessionFromTheRealPredictor) {
     p.position[1] = 0.15 * std::sin(0.1047 * t);
     p.position[2] = 0.2;
     p.reprojection_error = 0.2;
-    while (now_utime() < p.utime) std::this_thread::sleep_for(1ms);
+    // Paced in real time (the report measures the rate, 30 Hz), reading the bus meanwhile.
+    while (now_utime() < p.utime) bus.handle(1ms);
     bus.publish("OBJECT_POSITION", p);
   }
-  std::this_thread::sleep_for(500ms);
+  // sg-predictor forecasts on a 4 Hz grid: it has caught up once it has forecast from the last
+  // 0.25 s of the stream.
+  const int64_t last_sent = start + int64_t{kSent - 1} * 33'333;
+  ASSERT_TRUE(eventually(
+      bus, [&] { return newest_source >= last_sent - 250'000; }, 30s,
+      "a forecast from the last 0.25 s of the stream"));
   predictor.signal(SIGINT);
   const ProcessResult predicted = predictor.wait(10s);
-  std::this_thread::sleep_for(300ms);
-  logger.signal(SIGINT);
-  ASSERT_FALSE(logger.wait(10s).timed_out);
   int published = -1;
   const auto at = predicted.out.find("published ");
   ASSERT_NE(at, std::string::npos) << predicted.out << predicted.err;
   published = std::stoi(predicted.out.substr(at + 10));
+  // Stop lcm-logger once every position and forecast has reached it and it has read them all.
+  ASSERT_TRUE(eventually(
+      bus,
+      [&] {
+        return positions_heard >= kSent && forecasts_heard >= published &&
+               drained_bus(logger.pid(), 7922);
+      },
+      30s, "lcm-logger to read every position and forecast"));
+  logger.signal(SIGINT);
+  ASSERT_FALSE(logger.wait(10s).timed_out);
   ASSERT_GT(published, 10);
 
   const ProcessResult r = run({program("sg-report"), log, "--no-plots"}, 60s);

@@ -10,7 +10,8 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
-#include <thread>
+
+#include "tests/support/wait.hpp"
 
 extern char** environ;
 
@@ -50,6 +51,9 @@ Child::Child(const std::vector<std::string>& argv) {
                                    O_WRONLY | O_CREAT | O_TRUNC, 0644);
   posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, err_path_.c_str(),
                                    O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  // Nothing else of the test's: not its bus sockets, which would keep its group membership and
+  // make the child look subscribed (joined_bus) before it is.
+  posix_spawn_file_actions_addclosefrom_np(&actions, STDERR_FILENO + 1);
   std::vector<char*> args;
   for (const std::string& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
   args.push_back(nullptr);
@@ -76,22 +80,15 @@ void Child::signal(int signum) {
 
 ProcessResult Child::wait(std::chrono::milliseconds timeout) {
   ProcessResult result;
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
   int status = status_;
-  while (!reaped_) {
-    const pid_t done = waitpid(pid_, &status, WNOHANG);
-    if (done == pid_) {
-      reaped_ = true;
-      break;
-    }
-    if (std::chrono::steady_clock::now() >= deadline) {
-      result.timed_out = true;
-      kill(pid_, SIGKILL);
-      waitpid(pid_, &status, 0);
-      reaped_ = true;
-      break;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  if (!reaped_) {
+    reaped_ = wait_until([&] { return waitpid(pid_, &status, WNOHANG) == pid_; }, timeout);
+  }
+  if (!reaped_) {
+    result.timed_out = true;
+    kill(pid_, SIGKILL);
+    waitpid(pid_, &status, 0);
+    reaped_ = true;
   }
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   result.out = read_text(out_path_);

@@ -1,0 +1,58 @@
+// The bus probes on real processes: joined_bus() says a process has subscribed on a udpm port
+// (and not on another), drained_bus() that it has read what reached it.
+
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include "tests/integration/multicast_guard.hpp"
+#include "tests/support/subprocess.hpp"
+#include "tests/support/wait.hpp"
+
+namespace sg::test {
+namespace {
+
+using namespace std::chrono_literals;
+constexpr int kPort = 7930;
+
+// This test joins its port when it subscribes; its children hold none of its sockets: `sleep`
+// never joins, sg-bus-check receive does, on its port and not on another.
+TEST(JoinedBus, TrueOnceAProcessHasSubscribedOnThePort) {
+  ASSERT_TRUE(multicast_available(kPort));
+  Bus bus(test_url(kPort));
+  EXPECT_FALSE(joined_bus(getpid(), kPort)) << "LCM binds its socket at the first subscribe";
+  bus.subscribe_raw("ANY", [](const RawMessage&) {});
+  EXPECT_TRUE(joined_bus(getpid(), kPort));
+
+  Child idle({"sleep", "30"});
+  Child receiver({program("sg-bus-check"), "receive", "--count", "1", "--timeout", "30",
+                  "--lcm-url", test_url(kPort)});
+  EXPECT_TRUE(eventually([&] { return joined_bus(receiver.pid(), kPort); }, 30s,
+                         "sg-bus-check to join port 7930"));
+  EXPECT_FALSE(joined_bus(receiver.pid(), kPort + 1));
+  EXPECT_TRUE(idle.running());
+  EXPECT_FALSE(joined_bus(idle.pid(), kPort));
+}
+
+// A stopped receiver leaves a message in its socket (not drained); continued, it reads it.
+TEST(DrainedBus, FalseWhileAMessageWaitsInTheSocket) {
+  ASSERT_TRUE(multicast_available(kPort + 2));
+  Child receiver({program("sg-bus-check"), "receive", "--count", "1", "--timeout", "30",
+                  "--lcm-url", test_url(kPort + 2)});
+  ASSERT_TRUE(eventually([&] { return joined_bus(receiver.pid(), kPort + 2); }, 30s,
+                         "sg-bus-check to join port 7932"));
+  EXPECT_TRUE(drained_bus(receiver.pid(), kPort + 2));
+  receiver.signal(SIGSTOP);
+  Bus bus(test_url(kPort + 2));
+  const uint8_t byte = 1;
+  bus.publish_raw("OTHER", &byte, 1);
+  EXPECT_TRUE(eventually([&] { return !drained_bus(receiver.pid(), kPort + 2); }, 10s,
+                         "the message to wait in the stopped receiver's socket"));
+  receiver.signal(SIGCONT);
+  EXPECT_TRUE(eventually([&] { return drained_bus(receiver.pid(), kPort + 2); }, 30s,
+                         "the receiver to read it"));
+  EXPECT_FALSE(drained_bus(receiver.pid(), kPort)) << "no socket on that port";
+}
+
+}  // namespace
+}  // namespace sg::test
