@@ -10,12 +10,13 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
-#include <thread>
 
 #include "common/bus.hpp"
+#include "common/clock.hpp"
 #include "common/message_types.hpp"
 #include "tests/integration/multicast_guard.hpp"
 #include "tests/support/subprocess.hpp"
+#include "tests/support/wait.hpp"
 
 namespace sg::test {
 namespace {
@@ -31,6 +32,45 @@ void write_circle(const std::string& path) {
     out << t << "," << 0.45 + 0.15 * std::cos(a) << "," << 0.15 * std::sin(a) << ",0.10\n";
   }
 }
+
+/// The newest ARM_STATUS, OBJECT_TRAJECTORY and GROUND_TRUTH on a bus, and when the newest
+/// SIM_ARM_STATE arrived: what the test waits on.
+struct Watch {
+  explicit Watch(Bus& bus) {
+    bus.subscribe<stereograsp::arm_status_t>("ARM_STATUS", [this](const auto& m, const auto&) {
+      arm = m;
+      ++arm_statuses;
+    });
+    bus.subscribe<stereograsp::trajectory_t>("OBJECT_TRAJECTORY",
+                                             [this](const auto& m, const auto&) { forecast = m; });
+    bus.subscribe<stereograsp::point3_t>("GROUND_TRUTH",
+                                         [this](const auto& m, const auto&) { ball = m; });
+    bus.subscribe_raw("SIM_ARM_STATE",
+                      [this](const RawMessage& m) { sim_state_recv_utime = m.info.recv_utime; });
+  }
+
+  /// The driver is connected and the arm at rest.
+  bool arm_idle() const {
+    return arm_statuses > 0 && arm.state == stereograsp::arm_status_t::STATE_IDLE;
+  }
+  /// The newest forecast tracks the ball, from a frame captured after `utime`.
+  bool tracking_since(int64_t utime) const {
+    return forecast.status == stereograsp::trajectory_t::STATUS_TRACKING &&
+           forecast.source_utime > utime;
+  }
+  /// The tool centre point is within 3 cm of the point `standoff` above the true ball.
+  bool at_standoff(double standoff) const {
+    const double* p = arm.tool_position;
+    return std::hypot(p[0] - ball.position[0], p[1] - ball.position[1],
+                      p[2] - ball.position[2] - standoff) < 0.03;
+  }
+
+  stereograsp::arm_status_t arm{};
+  int arm_statuses = 0;
+  stereograsp::trajectory_t forecast{};
+  stereograsp::point3_t ball{};
+  int64_t sim_state_recv_utime = 0;
+};
 
 /// Stops a child with SIGINT and returns what it printed (for failure messages).
 std::string stop(Child& child) {
@@ -64,25 +104,36 @@ TEST(GraspLoop, TracksGraspsAndLiftsTheBall) {
   bus.subscribe<stereograsp::sim_arm_state_t>(
       "SIM_ARM_STATE",
       [&](const stereograsp::sim_arm_state_t& s, const ReceiveInfo&) { held = s.holding_object; });
+  Watch watch(bus);
 
   Child c550(
       {program("sg-c550-sim"), "--lcm-url", url, "--link", dir + "/c550", "--log-level", "warn"});
-  for (int i = 0; i < 100 && !std::filesystem::exists(dir + "/c550"); ++i)
-    std::this_thread::sleep_for(50ms);
+  ASSERT_TRUE(eventually([&] { return std::filesystem::exists(dir + "/c550"); }, 30s,
+                         "sg-c550-sim's pseudo-terminal"));
   Child driver({program("sg-arm-driver"), "--lcm-url", url, "--device", dir + "/c550"});
   Child vision({program("sg-vision"), "--lcm-url", url, "--calibration", dir + "/cams.yaml",
                 "--log-level", "warn"});
   Child predictor({program("sg-predictor"), "--lcm-url", url, "--coefficients",
                    dir + "/coeffs.yaml", "--log-level", "warn"});
   Child grasp({program("sg-grasp"), "--lcm-url", url});
-  std::this_thread::sleep_for(1s);
+  ASSERT_TRUE(eventually(
+      [&] {
+        return joined_bus(driver.pid(), 7920) && joined_bus(vision.pid(), 7920) &&
+               joined_bus(predictor.pid(), 7920) && joined_bus(grasp.pid(), 7920);
+      },
+      60s, "sg-arm-driver, sg-vision, sg-predictor and sg-grasp to join the bus"));
+  const int64_t filming = now_utime();
   Child cameras(
       {program("sg-camera-sim"), "--lcm-url", url, "--rate", "10", "--log-level", "warn"});
 
-  std::this_thread::sleep_for(3s);
+  ASSERT_TRUE(eventually(
+      bus, [&] { return watch.arm_idle() && watch.tracking_since(filming); }, 60s,
+      "the arm at rest and a forecast of the ball"));
   const ProcessResult track = run({program("sg-grasp-ctl"), "--lcm-url", url, "track"}, 20s);
   EXPECT_EQ(track.exit_code, 0) << track.out << track.err;
-  std::this_thread::sleep_for(12s);  // the arm follows the ball at its stand-off
+  ASSERT_TRUE(eventually(
+      bus, [&] { return watch.at_standoff(0.10); }, 60s,
+      "the arm to follow the ball at its stand-off (0.10 m)"));
   // A grasp is refused while the track is not fresh (a loaded machine's vision can lag a
   // moment): sg-grasp-ctl exits 4 (GRASP_STATUS.command_result a refusal); ask again then, as an
   // operator would.
@@ -91,10 +142,20 @@ TEST(GraspLoop, TracksGraspsAndLiftsTheBall) {
     grasped =
         run({program("sg-grasp-ctl"), "--lcm-url", url, "grasp", "--wait", "--timeout", "40"}, 60s);
     if (grasped.exit_code != 4) break;
-    std::this_thread::sleep_for(2s);
+    const int64_t refused = now_utime();  // ask again once the track is fresh
+    wait_until(
+        bus, [&] { return watch.tracking_since(refused); }, 30s);
   }
-  const auto deadline = std::chrono::steady_clock::now() + 3s;
-  while (std::chrono::steady_clock::now() < deadline) bus.handle(50ms);
+  // Catch up with the bus, unread while sg-grasp-ctl ran: a SIM_ARM_STATE sent since, the ball
+  // held (or the deadline, and the expectations below say what was seen).
+  const int64_t grasp_over = now_utime();
+  wait_until(
+      bus,
+      [&] {
+        return watch.sim_state_recv_utime > grasp_over && held && status &&
+               status->utime > grasp_over;  // a GRASP_STATUS sent since, too
+      },
+      15s);
 
   const std::string logs = "sg-grasp:\n" + stop(grasp) + "\nsg-arm-driver:\n" + stop(driver) +
                            "\nsg-c550-sim:\n" + stop(c550);
