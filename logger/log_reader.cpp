@@ -34,6 +34,60 @@ class QuietLcm {
   FILE* saved_;
 };
 
+/// The offset of the first magic at or after `pos`, reading `chunk` bytes at a time; -1 when there
+/// is none before the end of the file, or the file cannot be read.
+int64_t next_magic(FILE* f, int64_t pos, int64_t file_size, std::vector<uint8_t>& chunk) {
+  while (pos + 4 <= file_size) {
+    if (fseeko(f, pos, SEEK_SET) != 0) return -1;
+    const size_t got = std::fread(chunk.data(), 1, chunk.size(), f);
+    if (got < 4) return -1;
+    for (size_t i = 0; i + 4 <= got; ++i) {
+      if (chunk[i] == kMagic[0] && std::memcmp(&chunk[i], kMagic, 4) == 0) {
+        return pos + static_cast<int64_t>(i);
+      }
+    }
+    pos += static_cast<int64_t>(got) - 3;  // a magic may straddle the chunk's end
+  }
+  return -1;
+}
+
+/// The fields of an event header on disk (big-endian: magic, event number, timestamp, channel
+/// length, data length).
+struct EventHeader {
+  int64_t event_number = 0;
+  int64_t recv_utime = 0;
+  int64_t channel_length = 0;
+  int64_t data_length = 0;
+};
+
+/// What a magic found at some offset starts.
+enum class Candidate {
+  kEvent,       ///< a whole event: its header read, the file just after the header
+  kNotAHeader,  ///< a magic inside garbage or data
+  kOverflow,    ///< a header whose event runs past the end of the file
+  kUnreadable,  ///< the header could not be read
+};
+
+/// Reads and judges the header at `q` (into `h` when it is one).
+Candidate read_candidate(FILE* f, int64_t q, int64_t file_size, EventHeader& h) {
+  if (q + LogReader::kHeaderSize > file_size) return Candidate::kOverflow;
+  uint8_t header[LogReader::kHeaderSize];
+  fseeko(f, q, SEEK_SET);
+  if (std::fread(header, 1, LogReader::kHeaderSize, f) != LogReader::kHeaderSize) {
+    return Candidate::kUnreadable;
+  }
+  h.channel_length = be_int(header + 20, 4);
+  h.data_length = be_int(header + 24, 4);
+  if (h.channel_length <= 0 || h.channel_length > kMaxChannelLength || h.data_length < 0) {
+    return Candidate::kNotAHeader;
+  }
+  const int64_t end = q + LogReader::kHeaderSize + h.channel_length + h.data_length;
+  if (end > file_size) return Candidate::kOverflow;
+  h.recv_utime = be_int(header + 12, 8);
+  h.event_number = be_int(header + 4, 8);
+  return Candidate::kEvent;
+}
+
 }  // namespace
 
 LogReader::LogReader(const std::string& path) : path_(path) {
@@ -123,56 +177,35 @@ bool LogReader::recover(LogRecord& out) {
   std::vector<uint8_t> chunk(1 << 16);
   int64_t pos = skip_start;
   while (pos + 4 <= file_size_) {
-    // The next magic at or after pos.
-    if (fseeko(f, pos, SEEK_SET) != 0) break;
-    const size_t got = std::fread(chunk.data(), 1, chunk.size(), f);
-    if (got < 4) break;
-    int64_t q = -1;
-    for (size_t i = 0; i + 4 <= got; ++i) {
-      if (chunk[i] == kMagic[0] && std::memcmp(&chunk[i], kMagic, 4) == 0) {
-        q = pos + static_cast<int64_t>(i);
-        break;
-      }
-    }
-    if (q < 0) {
-      pos += static_cast<int64_t>(got) - 3;
-      continue;
-    }
-    uint8_t header[kHeaderSize];
-    if (q + kHeaderSize > file_size_) {
-      if (first_overflow < 0) first_overflow = q;
+    const int64_t q = next_magic(f, pos, file_size_, chunk);
+    if (q < 0) break;
+    EventHeader h;
+    const Candidate candidate = read_candidate(f, q, file_size_, h);
+    if (candidate == Candidate::kUnreadable) break;
+    if (candidate == Candidate::kOverflow && first_overflow < 0) first_overflow = q;
+    if (candidate != Candidate::kEvent) {
       pos = q + 1;
       continue;
     }
-    fseeko(f, q, SEEK_SET);
-    if (std::fread(header, 1, kHeaderSize, f) != kHeaderSize) break;
-    const int64_t channel_length = be_int(header + 20, 4);
-    const int64_t data_length = be_int(header + 24, 4);
-    if (channel_length <= 0 || channel_length > kMaxChannelLength || data_length < 0) {
-      pos = q + 1;  // a magic inside garbage or data, not a header
-      continue;
-    }
-    const int64_t end = q + kHeaderSize + channel_length + data_length;
-    if (end > file_size_) {
-      if (first_overflow < 0) first_overflow = q;
-      pos = q + 1;
-      continue;
-    }
-    buffer_.resize(static_cast<size_t>(channel_length + data_length));
+    buffer_.resize(static_cast<size_t>(h.channel_length + h.data_length));
     if (std::fread(buffer_.data(), 1, buffer_.size(), f) != buffer_.size()) break;
     if (q > skip_start) add_problem(LogProblem::Kind::kSkipped, skip_start, q - skip_start);
     out.channel.assign(reinterpret_cast<const char*>(buffer_.data()),
-                       static_cast<size_t>(channel_length));
-    out.recv_utime = be_int(header + 12, 8);
-    out.event_number = be_int(header + 4, 8);
-    out.data = buffer_.data() + channel_length;
-    out.size = static_cast<int>(data_length);
+                       static_cast<size_t>(h.channel_length));
+    out.recv_utime = h.recv_utime;
+    out.event_number = h.event_number;
+    out.data = buffer_.data() + h.channel_length;
+    out.size = static_cast<int>(h.data_length);
     out.offset = q;
-    end_of_last_ = end;
-    fseeko(f, end, SEEK_SET);  // LCM goes on from here
+    end_of_last_ = q + kHeaderSize + h.channel_length + h.data_length;
+    fseeko(f, end_of_last_, SEEK_SET);  // LCM goes on from here
     return true;
   }
-  // No whole event after the last good one.
+  note_lost_tail(skip_start, first_overflow);
+  return false;
+}
+
+void LogReader::note_lost_tail(int64_t skip_start, int64_t first_overflow) {
   if (first_overflow >= 0) {
     if (first_overflow > skip_start)
       add_problem(LogProblem::Kind::kSkipped, skip_start, first_overflow - skip_start);
@@ -181,7 +214,6 @@ bool LogReader::recover(LogRecord& out) {
     add_problem(LogProblem::Kind::kSkipped, skip_start, file_size_ - skip_start);
   }
   end_of_last_ = file_size_;
-  return false;
 }
 
 }  // namespace sg::logger

@@ -92,6 +92,9 @@ class LogReader {
 
  private:
   bool recover(LogRecord& out);
+  /// No whole event from `skip_start` to the end: the stretch is skipped, or truncated from the
+  /// first header whose event runs past the end (`first_overflow`, -1 if none); all is read.
+  void note_lost_tail(int64_t skip_start, int64_t first_overflow);
   void add_problem(LogProblem::Kind kind, int64_t offset, int64_t bytes);
   void report_progress(bool force);
 
