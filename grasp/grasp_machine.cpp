@@ -438,50 +438,69 @@ void GraspMachine::answered(bool failed, const std::string& how, int64_t now) {
       }
       return;
     case Kind::kHome:
-      if (status_.activity == GraspActivity::kHoming && next_ != NextAction::kHome) {
-        status_.activity = GraspActivity::kIdle;
-      }
-      if (failed) set_message(failure + "home" + request);
+      home_answered(failed, failure, request);
       return;
     case Kind::kTrack:
       if (failed) refuse(failure + "the tracking target" + request);
       return;
     case Kind::kApproach:
-      if (status_.state != GraspState::kGrasping || status_.activity != GraspActivity::kGrasping) {
-        return;
-      }
-      if (failed) {
-        status_.state = GraspState::kApproaching;
-        status_.last_action = GraspAction::kApproachObject;
-        refuse(failure + "the approach" + request + "; trying again");
-      } else {
-        status_.state = GraspState::kHandClosed;
-        plan(NextAction::kLift);
-      }
+      approach_answered(failed, failure, request);
       return;
     case Kind::kLift:
-      if (status_.state != GraspState::kHandClosed ||
-          status_.activity != GraspActivity::kGrasping) {
-        return;
-      }
-      if (failed) {
-        status_.activity = GraspActivity::kIdle;
-        status_.outcome = GraspOutcome::kFailed;
-        set_message(failure + "the lift" + request);
-      } else {
-        status_.state = GraspState::kObjectLifted;
-        judging_ = true;
-        nearest_ = std::numeric_limits<double>::infinity();
-        lifted_utime_ = now;
-        stopped_utime_.reset();
-      }
+      lift_answered(failed, failure, request, now);
       return;
     case Kind::kBackoff:
-      if (status_.activity == GraspActivity::kBackingOff) {
-        status_.activity = GraspActivity::kIdle;
-        if (failed) set_message("track lost; " + failure + "the back-off" + request);
-      }
+      backoff_answered(failed, failure, request);
       return;
+  }
+}
+
+void GraspMachine::home_answered(bool failed, const std::string& failure,
+                                 const std::string& request) {
+  if (status_.activity == GraspActivity::kHoming && next_ != NextAction::kHome) {
+    status_.activity = GraspActivity::kIdle;
+  }
+  if (failed) set_message(failure + "home" + request);
+}
+
+void GraspMachine::approach_answered(bool failed, const std::string& failure,
+                                     const std::string& request) {
+  if (status_.state != GraspState::kGrasping || status_.activity != GraspActivity::kGrasping) {
+    return;
+  }
+  if (failed) {  // back to q1: a1 again
+    status_.state = GraspState::kApproaching;
+    status_.last_action = GraspAction::kApproachObject;
+    refuse(failure + "the approach" + request + "; trying again");
+  } else {  // q2 -> q3: the hand closed on the ball; a3 next
+    status_.state = GraspState::kHandClosed;
+    plan(NextAction::kLift);
+  }
+}
+
+void GraspMachine::lift_answered(bool failed, const std::string& failure,
+                                 const std::string& request, int64_t now) {
+  if (status_.state != GraspState::kHandClosed || status_.activity != GraspActivity::kGrasping) {
+    return;
+  }
+  if (failed) {
+    status_.activity = GraspActivity::kIdle;
+    status_.outcome = GraspOutcome::kFailed;
+    set_message(failure + "the lift" + request);
+  } else {  // q3 -> q4: lifted; judge() decides the outcome from here
+    status_.state = GraspState::kObjectLifted;
+    judging_ = true;
+    nearest_ = std::numeric_limits<double>::infinity();
+    lifted_utime_ = now;
+    stopped_utime_.reset();
+  }
+}
+
+void GraspMachine::backoff_answered(bool failed, const std::string& failure,
+                                    const std::string& request) {
+  if (status_.activity == GraspActivity::kBackingOff) {
+    status_.activity = GraspActivity::kIdle;
+    if (failed) set_message("track lost; " + failure + "the back-off" + request);
   }
 }
 

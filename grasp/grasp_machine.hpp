@@ -319,6 +319,13 @@ class GraspMachine {
   void judge(int64_t now);
   /// The request in flight was executed, or `failed` (`how`: "rejected", "did not answer").
   void answered(bool failed, const std::string& how, int64_t now);
+  /// answered() for each kind whose answer moves the state or the activity; `failure` + what +
+  /// `request` is the message when the arm failed it.
+  void home_answered(bool failed, const std::string& failure, const std::string& request);
+  void approach_answered(bool failed, const std::string& failure, const std::string& request);
+  void lift_answered(bool failed, const std::string& failure, const std::string& request,
+                     int64_t now);
+  void backoff_answered(bool failed, const std::string& failure, const std::string& request);
   void refuse(std::string message);
   void set_message(std::string message);
   /// Ends a grasp in progress with kAborted (abort, release).
