@@ -80,9 +80,67 @@ arm_cmd_t move(int64_t sequence, double azimuth) {
   return c;
 }
 
+/// The value at fraction p (0..1) of the sorted values, the nearest rank.
 double percentile(std::vector<double> v, double p) {
   std::sort(v.begin(), v.end());
   return v[static_cast<size_t>(std::lround(p * static_cast<double>(v.size() - 1)))];
+}
+
+/// What each timed interaction took: the whole, and the driver's overhead in it, seconds.
+struct Timings {
+  std::vector<double> interaction, overhead;
+};
+
+/// Waits (up to 30 s) until the driver reports command `sequence` executed.
+void wait_executed(const sg::arm::ArmDriver& driver, int64_t sequence) {
+  const auto deadline = std::chrono::steady_clock::now() + 30s;
+  while (driver.status().first.last_executed_sequence != sequence) {
+    if (std::chrono::steady_clock::now() > deadline) {
+      throw std::runtime_error("command " + std::to_string(sequence) +
+                               " not executed in 30 s: " + driver.status().first.error);
+    }
+    std::this_thread::sleep_for(1ms);
+  }
+}
+
+/// Sends count + 1 moves, alternating between two azimuths, one at a time; times all but the
+/// first (which also sets SPEED).
+Timings time_interactions(sg::arm::ArmDriver& driver, int count) {
+  Timings t;
+  for (int64_t k = 1; k <= count + 1; ++k) {
+    driver.submit(move(k, 0.3 * static_cast<double>(k % 2)));
+    wait_executed(driver, k);
+    std::this_thread::sleep_for(50ms);  // the interaction's closing W2
+    if (k == 1) continue;               // the first one also sets SPEED
+    t.interaction.push_back(driver.status().first.interaction_time);
+    t.overhead.push_back(driver.last_overhead());
+  }
+  return t;
+}
+
+/// One table row: p50, p95 and max of `v`, times `scale`, in `unit`.
+void print_row(const char* name, const std::vector<double>& v, double scale, const char* unit) {
+  std::printf("%-28s %10.3f %s %10.3f %s %10.3f %s\n", name, percentile(v, 0.5) * scale, unit,
+              percentile(v, 0.95) * scale, unit, percentile(v, 1.0) * scale, unit);
+}
+
+/// The table: interaction, overhead and their ratio; a real line's transmission time; the goal.
+void print_table(int count, double delay_min, double delay_max, const Timings& t) {
+  std::printf(
+      "\n%d interactions (SPEED once, then MA + W2 each) with sg-c550-sim, delay %.2f-%.2f s\n",
+      count, delay_min, delay_max);
+  std::printf("%-28s %12s %12s %12s\n", "", "p50", "p95", "max");
+  print_row("interaction", t.interaction, 1e3, "ms");
+  print_row("driver overhead", t.overhead, 1e3, "ms");
+  std::vector<double> ratio(t.overhead.size());
+  for (size_t i = 0; i < ratio.size(); ++i) ratio[i] = t.overhead[i] / t.interaction[i];
+  print_row("overhead / interaction", ratio, 1e2, "% ");
+  // MA with six angles %.4f is about 60 characters, echoed; W2's reply about 70.
+  const double line_bytes = 2.0 * 60 + 5 + 2.0 * 3 + 80;
+  std::printf("a real 38,400 8N1 line would add about %.0f ms of transmission per interaction\n",
+              line_bytes * 10.0 / 38400.0 * 1e3);
+  std::printf("goal: driver overhead < 1 ms per interaction: %s\n",
+              percentile(t.overhead, 0.95) < 1e-3 ? "met (p95)" : "NOT met (p95)");
 }
 
 }  // namespace
@@ -105,43 +163,9 @@ int main(int argc, char** argv) {
     sg::arm::ArmDriver driver(sg::arm::ArmGeometry::a465(), settings,
                               [&] { return sg::arm::SerialPort::open(link, {}); });
     std::jthread worker([&](std::stop_token stop) { driver.run(stop); });
-
-    std::vector<double> interaction, overhead;
-    for (int64_t k = 1; k <= count + 1; ++k) {
-      driver.submit(move(k, 0.3 * static_cast<double>(k % 2)));
-      const auto deadline = std::chrono::steady_clock::now() + 30s;
-      while (driver.status().first.last_executed_sequence != k) {
-        if (std::chrono::steady_clock::now() > deadline) {
-          throw std::runtime_error("command " + std::to_string(k) +
-                                   " not executed in 30 s: " + driver.status().first.error);
-        }
-        std::this_thread::sleep_for(1ms);
-      }
-      std::this_thread::sleep_for(50ms);  // the interaction's closing W2
-      if (k == 1) continue;               // the first one also sets SPEED
-      interaction.push_back(driver.status().first.interaction_time);
-      overhead.push_back(driver.last_overhead());
-    }
+    const Timings timings = time_interactions(driver, count);
     worker.request_stop();
-    std::printf(
-        "\n%d interactions (SPEED once, then MA + W2 each) with sg-c550-sim, delay %.2f-%.2f s\n",
-        count, delay_min, delay_max);
-    std::printf("%-28s %12s %12s %12s\n", "", "p50", "p95", "max");
-    auto row = [](const char* name, const std::vector<double>& v, double scale, const char* unit) {
-      std::printf("%-28s %10.3f %s %10.3f %s %10.3f %s\n", name, percentile(v, 0.5) * scale, unit,
-                  percentile(v, 0.95) * scale, unit, percentile(v, 1.0) * scale, unit);
-    };
-    row("interaction", interaction, 1e3, "ms");
-    row("driver overhead", overhead, 1e3, "ms");
-    std::vector<double> ratio(overhead.size());
-    for (size_t i = 0; i < ratio.size(); ++i) ratio[i] = overhead[i] / interaction[i];
-    row("overhead / interaction", ratio, 1e2, "% ");
-    // MA with six angles %.4f is about 60 characters, echoed; W2's reply about 70.
-    const double line_bytes = 2.0 * 60 + 5 + 2.0 * 3 + 80;
-    std::printf("a real 38,400 8N1 line would add about %.0f ms of transmission per interaction\n",
-                line_bytes * 10.0 / 38400.0 * 1e3);
-    std::printf("goal: driver overhead < 1 ms per interaction: %s\n",
-                percentile(overhead, 0.95) < 1e-3 ? "met (p95)" : "NOT met (p95)");
+    print_table(count, delay_min, delay_max, timings);
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "arm_overhead: %s\n", e.what());
