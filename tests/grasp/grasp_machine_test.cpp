@@ -24,9 +24,7 @@ namespace {
 
 using arm::forward_kinematics;
 using arm::IkResult;
-using arm::motion_time;
 using arm::pose_from_xyz_rpy;
-using arm::rpy_from_rotation;
 using arm::solve_nearest;
 
 using Cmd = stereograsp::arm_cmd_t;

@@ -10,13 +10,6 @@
 namespace sg::grasp {
 namespace {
 
-using arm::forward_kinematics;
-using arm::IkResult;
-using arm::motion_time;
-using arm::pose_from_xyz_rpy;
-using arm::rpy_from_rotation;
-using arm::solve_nearest;
-
 using stereograsp::arm_cmd_t;
 using stereograsp::arm_status_t;
 using stereograsp::trajectory_t;

@@ -17,7 +17,6 @@ namespace {
 
 using arm::IkResult;
 using arm::pose_from_xyz_rpy;
-using arm::rpy_from_rotation;
 using arm::solve_nearest;
 using arm::forward_kinematics;
 using arm::motion_time;
