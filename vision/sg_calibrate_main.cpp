@@ -166,19 +166,17 @@ int run_register(const std::string& calibration_path, const std::string& points_
   return 0;
 }
 
-int run_robot(const std::string& url, const sg::vision::RobotCalibrationParams& params,
-              const std::string& out) {
-  const double timeout_s = params.timeout;
-  sg::install_shutdown_handlers();
-  sg::Bus bus(url);
-  // Sequence numbers from the clock, so they are newer than any the driver has seen.
-  sg::vision::RobotCalibration cal(params, sg::now_utime());
-  std::string arm_error;  // handlers run inside LCM's C code: they record, the loop throws
+/// What the robot calibration hears of ARM_STATUS. Handlers run inside LCM's C code: they record
+/// an error, and the loop throws it.
+struct ArmWatch {
+  std::string error;
   int64_t last_rejected = 0;
-  bool connected = false;  // no command before the driver reports its controller connected
-  bus.subscribe<stereograsp::arm_status_t>("ARM_STATUS", [&](const auto& s, const auto&) {
+  bool connected = false;  ///< no command before the driver reports its controller connected
+
+  void on_status(const stereograsp::arm_status_t& s, sg::vision::RobotCalibration& cal) {
+    using Status = stereograsp::arm_status_t;
     if (!connected) {
-      if (s.state != stereograsp::arm_status_t::STATE_IDLE) return;
+      if (s.state != Status::STATE_IDLE) return;
       connected = true;
       last_rejected = s.last_rejected_sequence;
     }
@@ -186,38 +184,67 @@ int run_robot(const std::string& url, const sg::vision::RobotCalibrationParams& 
       last_rejected = s.last_rejected_sequence;
       cal.on_arm_rejected(s.last_rejected_sequence, s.rejection_reason);
     }
-    if (s.state == stereograsp::arm_status_t::STATE_ERROR ||
-        s.state == stereograsp::arm_status_t::STATE_DISCONNECTED)
-      arm_error = "the arm reports " + std::string(s.error.empty() ? "an error" : s.error);
-    cal.on_arm_status(s.utime, s.last_executed_sequence,
-                      s.state == stereograsp::arm_status_t::STATE_IDLE);
-  });
+    if (s.state == Status::STATE_ERROR || s.state == Status::STATE_DISCONNECTED)
+      error = "the arm reports " + std::string(s.error.empty() ? "an error" : s.error);
+    cal.on_arm_status(s.utime, s.last_executed_sequence, s.state == Status::STATE_IDLE);
+  }
+};
+
+/// The ARM_COMMAND that takes the ball to a calibration stop, sent at `utime`.
+stereograsp::arm_cmd_t command_to(const sg::vision::ArmTarget& t, int64_t utime) {
+  stereograsp::arm_cmd_t cmd{};
+  cmd.utime = utime;
+  cmd.sequence = t.sequence;
+  cmd.mode = stereograsp::arm_cmd_t::MODE_CARTESIAN;
+  for (int i = 0; i < 3; ++i) cmd.position[i] = t.position[i], cmd.orientation[i] = t.rpy[i];
+  cmd.gripper = stereograsp::arm_cmd_t::GRIPPER_KEEP;
+  cmd.speed = t.speed;
+  cmd.sender = "sg-calibrate";
+  return cmd;
+}
+
+/// Warns of each skipped stop and why; returns how many were skipped.
+int warn_skipped(const std::vector<sg::vision::CalibrationStop>& stops) {
+  int skipped = 0;
+  for (const auto& s : stops) {
+    skipped += s.skipped;
+    if (!s.rejected.empty()) {
+      spdlog::warn("stop ({:.3f}, {:.3f}, {:.3f}) skipped: the arm refused it: {}", s.tool.x(),
+                   s.tool.y(), s.tool.z(), s.rejected);
+    } else if (s.skipped) {
+      spdlog::warn("stop ({:.3f}, {:.3f}, {:.3f}) skipped: the ball was not seen by both cameras",
+                   s.tool.x(), s.tool.y(), s.tool.z());
+    }
+  }
+  return skipped;
+}
+
+int run_robot(const std::string& url, const sg::vision::RobotCalibrationParams& params,
+              const std::string& out) {
+  const double timeout_s = params.timeout;
+  sg::install_shutdown_handlers();
+  sg::Bus bus(url);
+  // Sequence numbers from the clock, so they are newer than any the driver has seen.
+  sg::vision::RobotCalibration cal(params, sg::now_utime());
+  ArmWatch arm;
+  bus.subscribe<stereograsp::arm_status_t>(
+      "ARM_STATUS", [&](const auto& status, const auto&) { arm.on_status(status, cal); });
   bus.subscribe<stereograsp::blob_t>("BLOB_(LEFT|RIGHT)", [&](const auto& b, const auto&) {
     cal.on_blob(b.camera, b.utime, b.found, {b.centroid[0], b.centroid[1]});
   });
   std::string last_progress;
   auto last_change = std::chrono::steady_clock::now();
   bus.spin([&] {
-    if (!arm_error.empty())
-      throw std::runtime_error(arm_error + " at " + cal.progress() + "; nothing written");
-    if (!connected) {
+    if (!arm.error.empty())
+      throw std::runtime_error(arm.error + " at " + cal.progress() + "; nothing written");
+    if (!arm.connected) {
       if (std::chrono::steady_clock::now() - last_change > std::chrono::duration<double>(timeout_s))
         throw std::runtime_error("no ARM_STATUS with the arm connected and idle for " +
                                  std::to_string(static_cast<int>(timeout_s)) +
                                  " s (is sg-arm-driver running?); nothing written");
       return true;
     }
-    if (auto t = cal.next_target()) {
-      stereograsp::arm_cmd_t cmd{};
-      cmd.utime = sg::now_utime();
-      cmd.sequence = t->sequence;
-      cmd.mode = stereograsp::arm_cmd_t::MODE_CARTESIAN;
-      for (int i = 0; i < 3; ++i) cmd.position[i] = t->position[i], cmd.orientation[i] = t->rpy[i];
-      cmd.gripper = stereograsp::arm_cmd_t::GRIPPER_KEEP;
-      cmd.speed = t->speed;
-      cmd.sender = "sg-calibrate";
-      bus.publish("ARM_COMMAND", cmd);
-    }
+    if (auto t = cal.next_target()) bus.publish("ARM_COMMAND", command_to(*t, sg::now_utime()));
     const std::string progress = cal.progress();
     if (progress != last_progress) {
       spdlog::info("{}", progress);
@@ -233,17 +260,7 @@ int run_robot(const std::string& url, const sg::vision::RobotCalibrationParams& 
   });
   if (!cal.done())
     throw std::runtime_error("interrupted at " + cal.progress() + "; nothing written");
-  int skipped = 0;
-  for (const auto& s : cal.stops()) {
-    skipped += s.skipped;
-    if (!s.rejected.empty()) {
-      spdlog::warn("stop ({:.3f}, {:.3f}, {:.3f}) skipped: the arm refused it: {}", s.tool.x(),
-                   s.tool.y(), s.tool.z(), s.rejected);
-    } else if (s.skipped) {
-      spdlog::warn("stop ({:.3f}, {:.3f}, {:.3f}) skipped: the ball was not seen by both cameras",
-                   s.tool.x(), s.tool.y(), s.tool.z());
-    }
-  }
+  const int skipped = warn_skipped(cal.stops());
   sg::vision::StereoCalibration c;
   try {
     c = cal.solve();
