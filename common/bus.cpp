@@ -3,11 +3,13 @@
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 
+#include "common/log_format.hpp"
 #include "common/shutdown.hpp"
 
 namespace sg {
@@ -75,25 +77,57 @@ std::string describe_url(const std::string& url) {
   return shown;
 }
 
+/// For a `file://` URL read by LCM's file provider: "" when the log is whole, else why not.
+/// LCM's reader trusts every event length (common/log_format.hpp), so a damaged log is refused
+/// here, before LCM opens it.
+std::string damage_of_log_url(const std::string& url) {
+  if (url.rfind("file://", 0) != 0) return {};
+  const size_t query = url.find('?');
+  const std::string options = query == std::string::npos ? "" : url.substr(query + 1);
+  if (options.find("mode=w") != std::string::npos || options.find("mode=a") != std::string::npos)
+    return {};
+  const std::string path = url.substr(7, query == std::string::npos ? query : query - 7);
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (f == nullptr) return {};  // LCM says why it cannot open it
+  std::string damage;
+  if (fseeko(f, 0, SEEK_END) == 0) damage = log_format::first_damage(f, ftello(f));
+  std::fclose(f);
+  return damage;
+}
+
 }  // namespace
 
+/// Called by LCM's C dispatch: nothing may leave it by an exception.
 class Bus::RawHandler {
  public:
-  explicit RawHandler(std::function<void(const RawMessage&)> fn) : fn_(std::move(fn)) {}
-  void handleMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
-    RawMessage raw;
-    raw.info.channel = channel;
-    raw.info.recv_utime = rbuf->recv_utime;
-    raw.info.size = static_cast<int32_t>(rbuf->data_size);
-    raw.data = static_cast<const uint8_t*>(rbuf->data);
-    fn_(raw);
+  RawHandler(Bus& bus, std::function<void(const RawMessage&)> fn) : bus_(bus), fn_(std::move(fn)) {}
+  void handleMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel) noexcept {
+    try {
+      ++bus_.messages_received_;
+      RawMessage raw;
+      raw.info.channel = channel;
+      raw.info.recv_utime = rbuf->recv_utime;
+      raw.info.size = static_cast<int32_t>(rbuf->data_size);
+      raw.data = static_cast<const uint8_t*>(rbuf->data);
+      fn_(raw);
+    } catch (const std::exception& e) {
+      bus_.report_handler_error(channel, e.what());
+    } catch (...) {
+      bus_.report_handler_error(channel, "an exception that is not a std::exception");
+    }
   }
 
  private:
+  Bus& bus_;
   std::function<void(const RawMessage&)> fn_;
 };
 
 Bus::Bus(const std::string& url) : url_(url) {
+  if (const std::string damage = damage_of_log_url(url_); !damage.empty()) {
+    throw BusError("LCM URL '" + url_ + "': the log is damaged at " + damage +
+                   "; LCM's reader cannot read it safely (sg-bus-check verify-log lists the "
+                   "damage; sg-report reads around it)");
+  }
   const std::string complaint = capture_stderr([&] { lcm_ = std::make_unique<lcm::LCM>(url_); });
   const std::string shown = describe_url(url_);
   if (!lcm_->good()) {
@@ -116,11 +150,12 @@ bool Bus::publish_raw(const std::string& channel, const void* data, int size) {
 
 void Bus::subscribe_raw(const std::string& channel_regex,
                         std::function<void(const RawMessage&)> handler) {
-  handlers_.push_back(std::make_unique<RawHandler>(std::move(handler)));
+  handlers_.push_back(std::make_unique<RawHandler>(*this, std::move(handler)));
   lcm_->subscribe(channel_regex, &RawHandler::handleMessage, handlers_.back().get());
 }
 
 bool Bus::handle(std::chrono::milliseconds timeout) {
+  publish_process_status_if_due();
   const int status = lcm_->handleTimeout(static_cast<int>(timeout.count()));
   if (status > 0) return true;
   if (status == 0) return false;
@@ -137,13 +172,58 @@ void Bus::spin(const std::function<bool()>& keep_going, std::chrono::millisecond
   while (!shutdown_requested() && keep_going() && !end_of_log_) handle(poll);
 }
 
-void Bus::report_decode_error(const ReceiveInfo& info, const char* type_name) {
-  ++decode_errors_;
-  // The first few in full, then one line in a thousand: a wrong publisher must not flood logs.
-  if (decode_errors_ <= 10 || decode_errors_ % 1000 == 0) {
-    spdlog::warn("{}: dropped a {}-byte message that is not a valid {} ({} so far)", info.channel,
-                 info.size, type_name, decode_errors_);
-  }
+void Bus::note_problem(uint64_t count, const std::string& line) {
+  last_problem_ = line;
+  if (count <= 10 || count % 1000 == 0) spdlog::warn("{} ({} so far)", line, count);
+}
+
+void Bus::report_decode_error(const ReceiveInfo& info, const std::string& why) {
+  note_problem(++decode_errors_,
+               info.channel + ": dropped a " + std::to_string(info.size) + "-byte message: " + why);
+}
+
+void Bus::report_handler_error(const std::string& channel, const std::string& what) {
+  note_problem(++handler_errors_, channel + ": handler failed: " + what);
+}
+
+void Bus::note_refused(const std::string& channel, const std::string& why) {
+  note_problem(++refused_inputs_, channel + ": refused: " + why);
+}
+
+void Bus::announce(const std::string& process) {
+  process_ = process;
+  char name[256] = {};
+  host_ = gethostname(name, sizeof name - 1) == 0 ? name : "?";
+  next_status_ = {};
+  publish_process_status_if_due();
+}
+
+stereograsp::process_status_t Bus::process_status(int64_t utime) const {
+  stereograsp::process_status_t s{};
+  s.utime = utime;
+  s.process = process_;
+  s.host = host_;
+  s.pid = static_cast<int32_t>(getpid());
+  s.messages_received = static_cast<int64_t>(messages_received_);
+  s.decode_errors = static_cast<int64_t>(decode_errors_);
+  s.handler_errors = static_cast<int64_t>(handler_errors_);
+  s.refused_inputs = static_cast<int64_t>(refused_inputs_);
+  s.publish_errors = static_cast<int64_t>(publish_errors_);
+  s.last_problem = last_problem_.substr(0, 1000);
+  s.last_problem.erase(std::find(s.last_problem.begin(), s.last_problem.end(), '\0'),
+                       s.last_problem.end());  // a channel name may hold anything
+  return s;
+}
+
+void Bus::publish_process_status_if_due() {
+  if (process_.empty()) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (now < next_status_) return;
+  next_status_ = now + std::chrono::seconds(1);
+  const auto utime = std::chrono::duration_cast<std::chrono::microseconds>(
+                         std::chrono::system_clock::now().time_since_epoch())
+                         .count();
+  publish("PROCESS_STATUS", process_status(utime));
 }
 
 }  // namespace sg

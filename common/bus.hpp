@@ -9,6 +9,9 @@
 #include <string>
 #include <vector>
 
+#include "common/safe_decode.hpp"
+#include "stereograsp/process_status_t.hpp"
+
 namespace sg {
 
 /// The bus could not be opened or used; the message is one line that names the URL.
@@ -39,9 +42,14 @@ struct RawMessage {
 ///     bus.publish("OBJECT_TRAJECTORY", trajectory);
 ///     bus.spin();                                         // until SIGINT or SIGTERM
 ///
-/// A message that does not decode as the subscribed type (another type on the channel, a wrong
-/// size, trailing bytes) is counted in decode_errors() and logged with its channel and size; the
-/// handler is not called.
+/// No message can crash or exhaust the process. Every message is checked against its type before
+/// LCM's decoder sees it (sg::safe_decode: each length it claims within the bytes received and the
+/// type's bound); one that does not decode as the subscribed type (another type on the channel, a
+/// wrong size, a bad length, trailing bytes) is counted in decode_errors() and logged with its
+/// channel and the reason; the handler is not called. Whatever a handler throws is caught here,
+/// before it can unwind through LCM's C dispatch, counted in handler_errors() and logged; the bus
+/// goes on serving. A program that announce()s itself publishes these counts on PROCESS_STATUS
+/// once a second, with the refusals it counts itself (note_refused()).
 class Bus {
  public:
   /// Opens the bus; throws BusError when LCM cannot use `url` (unknown provider, bad address,
@@ -76,15 +84,16 @@ class Bus {
                  std::function<void(const Message&, const ReceiveInfo&)> handler) {
     subscribe_raw(channel_regex, [this, handler = std::move(handler)](const RawMessage& raw) {
       Message message{};
-      if (message.decode(raw.data, 0, raw.info.size) != raw.info.size) {
-        report_decode_error(raw.info, Message::getTypeName());
+      if (DecodeResult r = safe_decode(raw.data, raw.info.size, message); !r) {
+        report_decode_error(raw.info, r.reason);
         return;
       }
       handler(message, raw.info);
     });
   }
 
-  /// Calls `handler` with every message on matching channels, undecoded.
+  /// Calls `handler` with every message on matching channels, undecoded. What it throws is
+  /// caught and counted like a typed handler's.
   void subscribe_raw(const std::string& channel_regex,
                      std::function<void(const RawMessage&)> handler);
 
@@ -102,22 +111,48 @@ class Bus {
   /// True once a `file://` bus has reached the end of its log.
   bool end_of_log() const { return end_of_log_; }
 
+  /// Publishes a process_status_t on PROCESS_STATUS now and then once a second (from handle()
+  /// and spin()), for `process` (the program's name).
+  void announce(const std::string& process);
+
+  /// Counts a message the program decoded but refused (an implausible value, a stale time, an
+  /// unauthenticated command), with the one-line reason; logged like a decode error.
+  void note_refused(const std::string& channel, const std::string& why);
+
+  uint64_t messages_received() const { return messages_received_; }
   uint64_t decode_errors() const { return decode_errors_; }
+  uint64_t handler_errors() const { return handler_errors_; }
+  uint64_t refused_inputs() const { return refused_inputs_; }
   uint64_t publish_errors() const { return publish_errors_; }
+  /// The newest refusal or failure, one line ("" when none).
+  const std::string& last_problem() const { return last_problem_; }
+  /// The counts as PROCESS_STATUS carries them (process and host as announce()d).
+  stereograsp::process_status_t process_status(int64_t utime) const;
 
   /// The underlying LCM object, for what this wrapper does not cover.
   lcm::LCM& lcm() { return *lcm_; }
 
  private:
   class RawHandler;
-  void report_decode_error(const ReceiveInfo& info, const char* type_name);
+  void report_decode_error(const ReceiveInfo& info, const std::string& why);
+  void report_handler_error(const std::string& channel, const std::string& what);
+  /// Logs the first ten problems of a kind, then one in a thousand: a wrong publisher must not
+  /// flood the log.
+  void note_problem(uint64_t count, const std::string& line);
+  void publish_process_status_if_due();
 
   std::string url_;
   std::unique_ptr<lcm::LCM> lcm_;
   std::vector<std::unique_ptr<RawHandler>> handlers_;
   std::vector<uint8_t> buffer_;
+  uint64_t messages_received_ = 0;
   uint64_t decode_errors_ = 0;
+  uint64_t handler_errors_ = 0;
+  uint64_t refused_inputs_ = 0;
   uint64_t publish_errors_ = 0;
+  std::string last_problem_;
+  std::string process_, host_;  // as announce()d; "" = no PROCESS_STATUS
+  std::chrono::steady_clock::time_point next_status_{};
   bool end_of_log_ = false;
 };
 

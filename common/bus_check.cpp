@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "common/message_types.hpp"
+#include "common/safe_decode.hpp"
 
 namespace sg::bus_check {
 
@@ -162,6 +163,17 @@ void fill(sim_arm_state_t& m, Pattern& p) {
   m.gripper_opening = p.real();
   m.holding_object = p.flag();
 }
+void fill(process_status_t& m, Pattern& p) {
+  m.process = p.text();
+  m.host = p.text();
+  m.pid = p.below(100000);
+  m.messages_received = p.integer();
+  m.decode_errors = p.integer();
+  m.handler_errors = p.integer();
+  m.refused_inputs = p.integer();
+  m.publish_errors = p.integer();
+  m.last_problem = p.text();
+}
 
 template <class T>
 std::vector<uint8_t> encode_as(int64_t utime) {
@@ -175,7 +187,7 @@ std::vector<uint8_t> encode_as(int64_t utime) {
 template <class T>
 std::optional<int64_t> decode_utime(const uint8_t* data, int size) {
   T message{};
-  if (message.decode(data, 0, size) != size) return std::nullopt;
+  if (!safe_decode(data, size, message)) return std::nullopt;
   return message.utime;
 }
 

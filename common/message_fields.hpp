@@ -86,6 +86,13 @@ void visit_fields(M& m, V& v) {
   SG_FIELD(utime); SG_FIELD(joints); SG_FIELD(tool_position); SG_FIELD(tool_orientation);
   SG_FIELD(gripper_opening); SG_FIELD(holding_object);
 }
+template <class M, class V>
+  requires std::same_as<std::remove_const_t<M>, stereograsp::process_status_t>
+void visit_fields(M& m, V& v) {
+  SG_FIELD(utime); SG_FIELD(process); SG_FIELD(host); SG_FIELD(pid);
+  SG_FIELD(messages_received); SG_FIELD(decode_errors); SG_FIELD(handler_errors);
+  SG_FIELD(refused_inputs); SG_FIELD(publish_errors); SG_FIELD(last_problem);
+}
 
 // clang-format on
 #undef SG_FIELD

@@ -11,6 +11,7 @@
 #include "stereograsp/grasp_status_t.hpp"
 #include "stereograsp/image_t.hpp"
 #include "stereograsp/point3_t.hpp"
+#include "stereograsp/process_status_t.hpp"
 #include "stereograsp/sim_arm_state_t.hpp"
 #include "stereograsp/trajectory_t.hpp"
 
@@ -22,7 +23,8 @@ namespace sg {
 using MessageTypes = std::tuple<stereograsp::image_t, stereograsp::blob_t, stereograsp::point3_t,
                                 stereograsp::trajectory_t, stereograsp::arm_cmd_t,
                                 stereograsp::arm_status_t, stereograsp::grasp_command_t,
-                                stereograsp::grasp_status_t, stereograsp::sim_arm_state_t>;
+                                stereograsp::grasp_status_t, stereograsp::sim_arm_state_t,
+                                stereograsp::process_status_t>;
 
 /// Calls `fn.template operator()<T>()` for each type T in MessageTypes.
 template <class Fn>

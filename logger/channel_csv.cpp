@@ -12,6 +12,7 @@
 
 #include "common/message_fields.hpp"
 #include "common/message_types.hpp"
+#include "common/safe_decode.hpp"
 
 namespace sg::logger {
 namespace {
@@ -78,7 +79,7 @@ struct TypeEntry {
 template <class T>
 bool decode_into(const uint8_t* data, int size, Row& row) {
   T message{};  // value-initialised: GCC cannot see that decode() sets every field
-  if (message.decode(data, 0, size) != size) return false;
+  if (!safe_decode(data, size, message)) return false;
   visit_fields(message, row);
   return true;
 }

@@ -7,17 +7,13 @@
 #include <cstring>
 #include <lcm/lcm-cpp.hpp>
 
+#include "common/log_format.hpp"
+
 namespace sg::logger {
 namespace {
 
-constexpr uint8_t kMagic[4] = {0xED, 0xA1, 0xDA, 0x01};
-constexpr int32_t kMaxChannelLength = 1000;  // LCM refuses longer ones too
-
-int64_t be_int(const uint8_t* p, int n) {
-  uint64_t v = 0;
-  for (int i = 0; i < n; ++i) v = (v << 8) | p[i];
-  return n == 4 ? static_cast<int64_t>(static_cast<int32_t>(v)) : static_cast<int64_t>(v);
-}
+using log_format::EventHeader;
+using log_format::kMagic;
 
 /// LCM prints its own line on stderr for each damaged stretch ("Invalid header after log data");
 /// the reader reports the stretch itself, so LCM's line is sent to /dev/null while LCM reads.
@@ -51,15 +47,6 @@ int64_t next_magic(FILE* f, int64_t pos, int64_t file_size, std::vector<uint8_t>
   return -1;
 }
 
-/// The fields of an event header on disk (big-endian: magic, event number, timestamp, channel
-/// length, data length).
-struct EventHeader {
-  int64_t event_number = 0;
-  int64_t recv_utime = 0;
-  int64_t channel_length = 0;
-  int64_t data_length = 0;
-};
-
 /// What a magic found at some offset starts.
 enum class Candidate {
   kEvent,       ///< a whole event: its header read, the file just after the header
@@ -68,7 +55,7 @@ enum class Candidate {
   kUnreadable,  ///< the header could not be read
 };
 
-/// Reads and judges the header at `q` (into `h` when it is one).
+/// Reads and judges the header at `q` (into `h` when it is one; a magic must be at `q`).
 Candidate read_candidate(FILE* f, int64_t q, int64_t file_size, EventHeader& h) {
   if (q + LogReader::kHeaderSize > file_size) return Candidate::kOverflow;
   uint8_t header[LogReader::kHeaderSize];
@@ -76,16 +63,18 @@ Candidate read_candidate(FILE* f, int64_t q, int64_t file_size, EventHeader& h) 
   if (std::fread(header, 1, LogReader::kHeaderSize, f) != LogReader::kHeaderSize) {
     return Candidate::kUnreadable;
   }
-  h.channel_length = be_int(header + 20, 4);
-  h.data_length = be_int(header + 24, 4);
-  if (h.channel_length <= 0 || h.channel_length > kMaxChannelLength || h.data_length < 0) {
-    return Candidate::kNotAHeader;
-  }
-  const int64_t end = q + LogReader::kHeaderSize + h.channel_length + h.data_length;
-  if (end > file_size) return Candidate::kOverflow;
-  h.recv_utime = be_int(header + 12, 8);
-  h.event_number = be_int(header + 4, 8);
+  if (!log_format::parse_header(header, h)) return Candidate::kNotAHeader;
+  if (!h.fits(q, file_size)) return Candidate::kOverflow;
   return Candidate::kEvent;
+}
+
+/// True when a whole, plausible event starts exactly at `q` (its magic there, its lengths within
+/// bounds and the file); the file is left positioned at `q`.
+bool event_at(FILE* f, int64_t q, int64_t file_size) {
+  EventHeader h;
+  const bool good = read_candidate(f, q, file_size, h) == Candidate::kEvent;
+  fseeko(f, q, SEEK_SET);
+  return good;
 }
 
 }  // namespace
@@ -137,7 +126,9 @@ bool LogReader::next(LogRecord& out) {
   if (done_) return false;
   FILE* f = log_->getFilePtr();
   const lcm::LogEvent* event = nullptr;
-  {
+  // LCM's reader trusts the lengths in a header; it is given only an event checked here. Anything
+  // else (garbage, a damaged header) goes to recover(), which reads around it.
+  if (end_of_last_ < file_size_ && event_at(f, end_of_last_, file_size_)) {
     QuietLcm quiet;
     event = log_->readNextEvent();
   }

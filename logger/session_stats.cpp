@@ -7,6 +7,7 @@
 
 #include "common/grasp_names.hpp"
 #include "common/message_types.hpp"
+#include "common/safe_decode.hpp"
 
 namespace sg::logger {
 namespace {
@@ -55,7 +56,7 @@ const TypeEntry* find_type(const uint8_t* data, int size) {
 
 template <class T>
 bool decode_exact(const uint8_t* data, int size, T& message) {
-  return message.decode(data, 0, size) == size;
+  return static_cast<bool>(safe_decode(data, size, message));
 }
 
 const char* command_name(int c) {

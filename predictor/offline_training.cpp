@@ -10,6 +10,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "common/safe_decode.hpp"
+#include "logger/log_reader.hpp"
 #include "predictor/burg.hpp"
 #include "stereograsp/point3_t.hpp"
 
@@ -39,13 +41,19 @@ std::vector<Measurement> read_training_csv(const std::string& path) {
 }
 
 std::vector<Measurement> read_training_log(const std::string& path, const std::string& channel) {
-  lcm::LogFile log(path, "r");
-  if (!log.good()) throw std::runtime_error(path + ": cannot open as an LCM log (or give a .csv)");
+  // sg::logger::LogReader, not lcm::LogFile: LCM's reader crashes on a damaged event length.
+  std::unique_ptr<logger::LogReader> log;
+  try {
+    log = std::make_unique<logger::LogReader>(path);
+  } catch (const logger::LogReadError& e) {
+    throw std::runtime_error(std::string(e.what()) + " (or give a .csv)");
+  }
   std::vector<Measurement> out;
-  while (const lcm::LogEvent* e = log.readNextEvent()) {
-    if (e->channel != channel) continue;
+  logger::LogRecord e;
+  while (log->next(e)) {
+    if (e.channel != channel) continue;
     stereograsp::point3_t p{};
-    if (p.decode(e->data, 0, e->datalen) != e->datalen || !p.visible) continue;
+    if (!sg::safe_decode(e.data, e.size, p) || !p.visible) continue;
     out.push_back({p.utime, true, {p.position[0], p.position[1], p.position[2]}});
   }
   return out;

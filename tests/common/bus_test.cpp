@@ -3,6 +3,7 @@
 #include "common/bus.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include "common/message_types.hpp"
 #include "common/shutdown.hpp"
@@ -132,6 +133,94 @@ TEST(Bus, FileUrlReportsEndOfLog) {
   EXPECT_TRUE(reader.end_of_log());
   EXPECT_EQ(utimes, (std::vector<int64_t>{42, 43}));
   std::remove(path.c_str());
+}
+
+// A file:// bus refuses a log whose event lengths LCM's reader would trust into a crash, with one
+// line that says where.
+TEST(Bus, FileUrlRefusesADamagedLog) {
+  const std::string path = "/tmp/sg-bus-damaged-" + std::to_string(getpid()) + ".lcmlog";
+  {
+    Bus writer("file://" + path + "?mode=w");
+    writer.publish("OBJECT_POSITION", make_point(42, 1.0));
+  }
+  const int64_t good_size = 28 + 15 + make_point(0, 0).getEncodedSize();
+  {
+    std::FILE* f = std::fopen(path.c_str(), "ab");
+    // magic, event number 1, timestamp 0, channel length 15, data length 0x7fffffff
+    const uint8_t header[28] = {0xED, 0xA1, 0xDA, 0x01, 0, 0, 0, 0, 0, 0,  0,    1,    0,    0,
+                                0,    0,    0,    0,    0, 0, 0, 0, 0, 15, 0x7f, 0xff, 0xff, 0xff};
+    std::fwrite(header, 1, sizeof header, f);
+    std::fclose(f);
+  }
+  try {
+    Bus reader("file://" + path + "?mode=r&speed=0");
+    ADD_FAILURE() << "a damaged log was opened";
+  } catch (const BusError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("damaged at byte " + std::to_string(good_size)), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+  std::remove(path.c_str());
+}
+
+// A handler that throws does not end the process: the exception is caught before LCM's C code,
+// counted, and the next message is served.
+TEST(Bus, HandlerExceptionsAreCaughtCountedAndServingGoesOn) {
+  Bus bus("memq://");
+  int calls = 0;
+  bus.subscribe<point3_t>("P", [&](const point3_t& p, const ReceiveInfo&) {
+    ++calls;
+    if (p.utime == 1) throw std::length_error("basic_string::_M_create");
+    if (p.utime == 2) throw 42;
+  });
+  for (int i = 1; i <= 3; ++i) bus.publish("P", make_point(i, 0));
+  while (bus.handle(10ms)) {
+  }
+  EXPECT_EQ(calls, 3);
+  EXPECT_EQ(bus.handler_errors(), 2u);
+  EXPECT_EQ(bus.messages_received(), 3u);
+  EXPECT_NE(bus.last_problem().find("P: handler failed"), std::string::npos) << bus.last_problem();
+}
+
+// The packet that aborted every process on main (an arm_cmd_t whose sender length is 0) is
+// refused with its reason, and the subscriber is never called.
+TEST(Bus, ZeroLengthStringIsRefusedNotFatal) {
+  Bus bus("memq://");
+  int calls = 0;
+  bus.subscribe<stereograsp::arm_cmd_t>(
+      "ARM_COMMAND", [&](const stereograsp::arm_cmd_t&, const ReceiveInfo&) { ++calls; });
+  stereograsp::arm_cmd_t c{};
+  c.sender = "x";
+  std::vector<uint8_t> bytes = encode_message(c);
+  const size_t at = bytes.size() - 2 - 4;
+  bytes[at] = bytes[at + 1] = bytes[at + 2] = bytes[at + 3] = 0;
+  bus.publish_raw("ARM_COMMAND", bytes.data(), static_cast<int>(bytes.size()));
+  bus.publish("ARM_COMMAND", c);
+  while (bus.handle(10ms)) {
+  }
+  EXPECT_EQ(calls, 1);
+  EXPECT_EQ(bus.decode_errors(), 1u);
+  EXPECT_NE(bus.last_problem().find("'sender'"), std::string::npos) << bus.last_problem();
+}
+
+// An announced process publishes its counts on PROCESS_STATUS, and note_refused() counts there.
+TEST(Bus, AnnouncedProcessPublishesItsCounts) {
+  Bus bus("memq://");
+  std::vector<stereograsp::process_status_t> statuses;
+  bus.subscribe<stereograsp::process_status_t>(
+      "PROCESS_STATUS",
+      [&](const stereograsp::process_status_t& s, const ReceiveInfo&) { statuses.push_back(s); });
+  bus.note_refused("OBJECT_POSITION", "x = 1e300 m is outside the workspace");
+  bus.announce("sg-test");
+  while (bus.handle(10ms)) {
+  }
+  ASSERT_EQ(statuses.size(), 1u) << "one at once, the next a second later";
+  EXPECT_EQ(statuses[0].process, "sg-test");
+  EXPECT_EQ(statuses[0].pid, static_cast<int32_t>(getpid()));
+  EXPECT_EQ(statuses[0].refused_inputs, 1);
+  EXPECT_EQ(statuses[0].last_problem,
+            "OBJECT_POSITION: refused: x = 1e300 m is outside the workspace");
+  EXPECT_FALSE(statuses[0].host.empty());
 }
 
 }  // namespace

@@ -167,6 +167,39 @@ TEST(LogReader, GarbageInTheMiddleIsSkippedAndReported) {
   EXPECT_EQ(r.offsets[2], 2 * two + 37);
 }
 
+/// A header (magic, event number, timestamp) claiming `channel_length` and `data_length`.
+std::vector<uint8_t> header_claiming(uint32_t channel_length, uint32_t data_length) {
+  std::vector<uint8_t> h = {0xED, 0xA1, 0xDA, 0x01, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 9};
+  for (const uint32_t v : {channel_length, data_length})
+    for (int i = 0; i < 4; ++i) h.push_back(static_cast<uint8_t>(v >> (24 - 8 * i)));
+  return h;
+}
+
+// A header claiming 0x7fffffff bytes of data (LCM's own reader calloc()s INT_MIN bytes for it and
+// crashes, measured on main with sg-report), or 0x7fffffff of channel, at the start of a log and
+// between events: never handed to LCM; each is a skipped stretch and every real event is read.
+TEST(LogReader, HugeEventLengthsAreSkippedNotTrusted) {
+  for (const auto& [channel_length, data_length] :
+       {std::pair<uint32_t, uint32_t>{15, 0x7fffffff}, {0x7fffffff, 24}, {15, 0x80000000}}) {
+    const std::string path = test::make_temp_dir() + "/huge.lcmlog";
+    const std::vector<uint8_t> bad = header_claiming(channel_length, data_length);
+    {
+      LogBuilder b(path);
+      b.raw(bad);
+      for (int64_t t : kFive) {
+        b.event("OBJECT_POSITION", t, position_bytes(t));
+        if (t == 300) b.raw(bad);
+      }
+    }
+    const int64_t one = 28 + 15 + static_cast<int64_t>(position_bytes(0).size());
+    const ReadBack r = read_all(path);
+    EXPECT_EQ(r.utimes, kFive) << channel_length << " " << data_length;
+    ASSERT_EQ(r.problems.size(), 2u);
+    EXPECT_EQ(r.problems[0].text, "28 bytes skipped at offset 0");
+    EXPECT_EQ(r.problems[1].text, "28 bytes skipped at offset " + std::to_string(28 + 3 * one));
+  }
+}
+
 // Garbage holding a magic followed by absurd lengths (a false header) is skipped too.
 TEST(LogReader, FalseHeaderInGarbageIsSkipped) {
   const std::string path = test::make_temp_dir() + "/false_header.lcmlog";
