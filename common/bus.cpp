@@ -155,7 +155,7 @@ void Bus::subscribe_raw(const std::string& channel_regex,
 }
 
 bool Bus::handle(std::chrono::milliseconds timeout) {
-  publish_process_status_if_due();
+  tick();
   const int status = lcm_->handleTimeout(static_cast<int>(timeout.count()));
   if (status > 0) return true;
   if (status == 0) return false;
@@ -195,7 +195,7 @@ void Bus::announce(const std::string& process) {
   char name[256] = {};
   host_ = gethostname(name, sizeof name - 1) == 0 ? name : "?";
   next_status_ = {};
-  publish_process_status_if_due();
+  tick();
 }
 
 stereograsp::process_status_t Bus::process_status(int64_t utime) const {
@@ -215,7 +215,7 @@ stereograsp::process_status_t Bus::process_status(int64_t utime) const {
   return s;
 }
 
-void Bus::publish_process_status_if_due() {
+void Bus::tick() {
   if (process_.empty()) return;
   const auto now = std::chrono::steady_clock::now();
   if (now < next_status_) return;

@@ -115,6 +115,11 @@ class Bus {
   /// and spin()), for `process` (the program's name).
   void announce(const std::string& process);
 
+  /// Publishes PROCESS_STATUS if a second has passed since the last one (after announce()).
+  /// handle() and spin() call it; a program that polls LCM's file descriptor itself and calls
+  /// handle() only when a message is there calls it in its loop.
+  void tick();
+
   /// Counts a message the program decoded but refused (an implausible value, a stale time, an
   /// unauthenticated command), with the one-line reason; logged like a decode error.
   void note_refused(const std::string& channel, const std::string& why);
@@ -139,7 +144,6 @@ class Bus {
   /// Logs the first ten problems of a kind, then one in a thousand: a wrong publisher must not
   /// flood the log.
   void note_problem(uint64_t count, const std::string& line);
-  void publish_process_status_if_due();
 
   std::string url_;
   std::unique_ptr<lcm::LCM> lcm_;

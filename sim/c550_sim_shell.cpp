@@ -123,6 +123,7 @@ void C550SimShell::wait(double seconds) {
     throw std::runtime_error(system_error("poll"));
   }
   if (fds[0].revents & POLLIN) bus_.handle(std::chrono::milliseconds(0));
+  bus_.tick();
 }
 
 void C550SimShell::serve(double t) {

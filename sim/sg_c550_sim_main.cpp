@@ -46,6 +46,7 @@ int main(int argc, char** argv) {
     sg::install_shutdown_handlers();
     sg::sim::C550Controller controller(sg::arm::load_arm_geometry(config), settings.controller);
     sg::Bus bus(common.lcm_url);
+    bus.announce("sg-c550-sim");
     sg::sim::C550SimShell shell(settings, controller, bus);
     return shell.run();
   });

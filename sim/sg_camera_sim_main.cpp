@@ -126,6 +126,7 @@ int run_write(sg::sim::CameraSimulator& sim, const Options& o, int64_t frames) {
 int run_bus(sg::sim::CameraSimulator& sim, const Options& o, int64_t frames, bool jpeg,
             const std::string& url) {
   sg::Bus bus(url);
+  bus.announce("sg-camera-sim");
   sg::sim::ArmState arm;
   bus.subscribe<stereograsp::sim_arm_state_t>(
       "SIM_ARM_STATE", [&](const stereograsp::sim_arm_state_t& m, const sg::ReceiveInfo&) {

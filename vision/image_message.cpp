@@ -1,11 +1,30 @@
 #include "vision/image_message.hpp"
 
+#include <turbojpeg.h>
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace sg::vision {
 
 using stereograsp::image_t;
+
+std::optional<std::pair<int, int>> jpeg_declared_size(const std::vector<uint8_t>& jpeg) {
+  struct Handle {
+    tjhandle h = tjInitDecompress();
+    ~Handle() {
+      if (h != nullptr) tjDestroy(h);
+    }
+  };
+  thread_local Handle decompressor;
+  if (decompressor.h == nullptr || jpeg.empty()) return std::nullopt;
+  int width = 0, height = 0, subsampling = 0, colorspace = 0;
+  if (tjDecompressHeader3(decompressor.h, jpeg.data(), static_cast<unsigned long>(jpeg.size()),
+                          &width, &height, &subsampling, &colorspace) != 0) {
+    return std::nullopt;
+  }
+  return std::pair{width, height};
+}
 
 image_t encode_image(const cv::Mat& bgr, int8_t camera, int64_t frame_number, int64_t utime,
                      bool jpeg, int jpeg_quality) {
@@ -33,12 +52,19 @@ std::optional<cv::Mat> decode_image(const image_t& m, std::string* error) {
     if (error) *error = what;
     return std::nullopt;
   };
-  if (m.width <= 0 || m.height <= 0 || m.width > 16384 || m.height > 16384)
+  if (m.width <= 0 || m.height <= 0 || static_cast<int64_t>(m.width) * m.height > kMaxImagePixels)
     return fail("image size " + std::to_string(m.width) + "x" + std::to_string(m.height) +
-                " is not valid");
+                " is not valid (at most " + std::to_string(kMaxImagePixels) + " pixels)");
   if (m.size != static_cast<int32_t>(m.data.size()))
     return fail("size field does not match the data");
   if (m.pixel_format == image_t::FORMAT_JPEG) {
+    const auto declared = jpeg_declared_size(m.data);
+    if (!declared) return fail("JPEG header does not decode");
+    if (declared->first != m.width || declared->second != m.height) {
+      return fail("JPEG header declares " + std::to_string(declared->first) + "x" +
+                  std::to_string(declared->second) + ", the message " + std::to_string(m.width) +
+                  "x" + std::to_string(m.height));
+    }
     cv::Mat bgr = cv::imdecode(m.data, cv::IMREAD_COLOR);
     if (bgr.empty()) return fail("JPEG data does not decode");
     if (bgr.cols != m.width || bgr.rows != m.height)

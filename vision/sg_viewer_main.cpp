@@ -28,6 +28,7 @@ int run(const std::string& url, sg::vision::ViewerSession& session, int64_t max_
         bool wait_for_blobs) {
   sg::install_shutdown_handlers();
   sg::Bus bus(url);
+  bus.announce("sg-viewer");
   bus.subscribe<image_t>("CAMERA_(LEFT|RIGHT)", [&](const image_t& m, const sg::ReceiveInfo& info) {
     std::string error;
     auto image = sg::vision::decode_image(m, &error);

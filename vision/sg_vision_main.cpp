@@ -269,6 +269,7 @@ int main(int argc, char** argv) {
           "--publish-images republishes frames from cameras or files, not from the bus");
     sg::install_shutdown_handlers();
     sg::Bus bus(common.lcm_url);
+    bus.announce("sg-vision");
     const cv::Size size = calibration
                               ? cv::Size(calibration->left.width(), calibration->left.height())
                               : cv::Size(o.width, o.height);
