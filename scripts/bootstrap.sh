@@ -6,18 +6,21 @@
 #   scripts/bootstrap.sh --no-build      install only
 #   scripts/bootstrap.sh --build-dir DIR build elsewhere
 #   scripts/bootstrap.sh --debug         Debug build instead of Release
+#   scripts/bootstrap.sh --with-clang    also clang and its runtimes (scripts/fuzz.sh)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 build=1
 build_dir=build
 build_type=Release
+with_clang=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --no-build) build=0 ;;
     --build-dir) build_dir="$2"; shift ;;
     --debug) build_type=Debug ;;
-    -h|--help) sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --with-clang) with_clang=1 ;;
+    -h|--help) sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "bootstrap.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
   shift
@@ -34,9 +37,13 @@ packages=(
   libturbojpeg0-dev                                # a JPEG's size from its header, before decoding
   libgtest-dev libgmock-dev libbenchmark-dev       # tests and benchmarks
   nlohmann-json3-dev                               # sg-report's report.json (and its tests)
+  libsodium-dev pkg-config                         # signed commands (auth/: HMAC, the lab key)
   gnuplot-nox                                      # sg-report's PNG figures (pngcairo terminal)
   iproute2 util-linux                              # ip and unshare for scripts/multicast.sh
 )
+# Only for scripts/fuzz.sh: clang with libFuzzer, ASan and UBSan runtimes (libclang-rt-dev),
+# and llvm-symbolizer (llvm) for file:line in sanitizer reports.
+[ "$with_clang" -eq 0 ] || packages+=(clang libclang-rt-dev llvm)
 
 missing=()
 for p in "${packages[@]}"; do

@@ -2,11 +2,51 @@
 # Installs what is missing, builds, and runs every test. Exits non-zero on any failure.
 # Arguments go to ctest (e.g. scripts/test.sh -R Config).
 #
+#   scripts/test.sh [CTEST ARGS]             build/ and every test
+#   scripts/test.sh --sanitize [CTEST ARGS]  the same suite built with AddressSanitizer and
+#                                            UndefinedBehaviorSanitizer in build-asan/ (no
+#                                            benchmarks); any sanitizer report, in a test or in
+#                                            a process it starts, fails the run (docs/fuzzing.md)
+#
 # The tests run in a private network namespace (scripts/multicast.sh run), so their multicast
 # never leaves the machine and never meets a running system's bus.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-scripts/bootstrap.sh
 jobs=$(nproc)
-scripts/multicast.sh run ctest --test-dir build --output-on-failure -j "$jobs" "$@"
+
+if [ "${1:-}" != "--sanitize" ]; then
+  scripts/bootstrap.sh
+  scripts/multicast.sh run ctest --test-dir build --output-on-failure -j "$jobs" "$@"
+  exit 0
+fi
+shift
+
+# ---- --sanitize ----
+scripts/bootstrap.sh --no-build
+build=build-asan
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DSG_SANITIZE=ON -DSG_BUILD_BENCH=OFF >/dev/null
+cmake --build "$build" -j "$jobs"
+
+# Every report also goes to a file (log_path), so a report in a process a test starts fails the
+# run even when the test only expected that process to exit non-zero.
+reports="$PWD/$build/sanitizer-reports"
+rm -rf "$reports" && mkdir -p "$reports"
+supp="$PWD/scripts/sanitizer"
+export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1:detect_stack_use_after_return=0:strict_string_checks=1:check_initialization_order=1:log_path=$reports/asan"
+export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1:log_path=$reports/ubsan"
+export LSAN_OPTIONS="suppressions=$supp/lsan.supp:print_suppressions=0"
+
+status=0
+scripts/multicast.sh run ctest --test-dir "$build" --output-on-failure -j "$jobs" "$@" || status=$?
+
+if compgen -G "$reports/*" >/dev/null; then
+  echo "test.sh --sanitize: sanitizer reports:" >&2
+  for f in "$reports"/*; do
+    echo "==== $f" >&2
+    cat "$f" >&2
+  done
+  status=1
+fi
+[ "$status" -eq 0 ] && echo "test.sh --sanitize: every test passed, no sanitizer report"
+exit "$status"
