@@ -6,6 +6,14 @@
 // `send` publishes one message of every stereograsp type in turn on BUS_CHECK_<TYPE>, each with
 // contents derived from its utime; `receive` checks every byte and reports loss, corruption and
 // latency; `verify-log` checks a log that lcm-logger recorded of such a stream.
+//
+//   sg-bus-check hostile --rate 2000 --random-bodies 1000 --seed 1   # issue 15's hostile bus
+//
+// `hostile` publishes, on every channel the system reads, packets that are almost messages of
+// the channel's type: each 4-byte window of a typical message set to 0, -1, 2^31-1 and 10^9,
+// random bodies behind the type's fingerprint, every truncation, and the other types' messages
+// (common/bus_check.hpp). Every process must survive it, within its memory, and the arm must not
+// move (scripts/hostile_bus.sh, docs/reliability.md).
 
 #include <spdlog/spdlog.h>
 
@@ -13,9 +21,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <lcm/lcm-cpp.hpp>
+#include <limits>
 #include <map>
 #include <set>
+#include <stdexcept>
 #include <thread>
 #include <vector>
 
@@ -174,6 +185,85 @@ int run_verify_log(const std::string& path, int64_t expected) {
   return complete && clean ? 0 : 1;
 }
 
+struct HostileOptions {
+  sg::bus_check::HostileSettings settings;
+  double rate_hz = 2000.0;
+  std::vector<std::string> channels;
+  int64_t first = 0;
+  int64_t last = std::numeric_limits<int64_t>::max();
+  bool list = false;
+  int64_t describe = -1;
+  std::string save;
+};
+
+/// --list and --describe N [--save FILE]: what the attack would send, without a bus.
+int show_hostile(const sg::bus_check::HostilePlan& plan, const HostileOptions& options) {
+  std::string channel;
+  if (options.list) {
+    for (int64_t n = 0; n < plan.total(); ++n) {
+      const sg::bus_check::HostilePacket* p = plan.at(n, &channel);
+      std::printf("%lld %s %zu %s\n", static_cast<long long>(n), channel.c_str(), p->bytes.size(),
+                  p->what.c_str());
+    }
+    return 0;
+  }
+  const sg::bus_check::HostilePacket* p = plan.at(options.describe, &channel);
+  if (p == nullptr) throw std::runtime_error("no packet " + std::to_string(options.describe));
+  std::printf("%lld %s %zu %s\n", static_cast<long long>(options.describe), channel.c_str(),
+              p->bytes.size(), p->what.c_str());
+  if (!options.save.empty()) {
+    std::ofstream out(options.save, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(p->bytes.data()),
+              static_cast<std::streamsize>(p->bytes.size()));
+    if (!out) throw std::runtime_error("cannot write " + options.save);
+  }
+  return 0;
+}
+
+int run_hostile(sg::Bus& bus, sg::bus_check::HostilePlan& plan, const HostileOptions& options) {
+  const int64_t total = plan.total();
+  std::fprintf(stderr, "hostile: %lld packets on %zu channels at %.0f/s (seed %llu, K = %d)\n",
+               static_cast<long long>(total), plan.channels.size(), options.rate_hz,
+               static_cast<unsigned long long>(options.settings.seed),
+               options.settings.random_bodies);
+  const auto start = steady_clock::now();
+  const int64_t sent = sg::bus_check::run_attack(
+      plan, options.first, options.last, options.rate_hz,
+      [&](const std::string& channel, const sg::bus_check::HostilePacket& p) {
+        return bus.publish_raw(channel, p.bytes.data(), static_cast<int>(p.bytes.size()));
+      },
+      [](int64_t done, int64_t due) {
+        std::fprintf(stderr, "hostile: %lld of %lld sent\n", static_cast<long long>(done),
+                     static_cast<long long>(due));
+      },
+      [] { return sg::shutdown_requested(); });
+  const double seconds = duration<double>(steady_clock::now() - start).count();
+  std::printf("hostile: sent %lld packets in %.2f s (%lld publish errors)\n%s",
+              static_cast<long long>(sent), seconds, static_cast<long long>(bus.publish_errors()),
+              sg::bus_check::attack_summary(plan).c_str());
+  return bus.publish_errors() == 0 ? 0 : 1;
+}
+
+void add_hostile_options(CLI::App& cmd, HostileOptions& o) {
+  cmd.add_option("--rate", o.rate_hz, "packets per second (not a flood)")
+      ->check(CLI::Range(1.0, 1e6))
+      ->capture_default_str();
+  cmd.add_option("--seed", o.settings.seed, "seed of the random bodies")->capture_default_str();
+  cmd.add_option("--random-bodies", o.settings.random_bodies, "random bodies per type (K)")
+      ->check(CLI::Range(0, 10000000))
+      ->capture_default_str();
+  cmd.add_option("--channels", o.channels, "only these channels (comma-separated)")->delimiter(',');
+  cmd.add_flag("!--no-windows", o.settings.windows, "leave out the 4-byte windows");
+  cmd.add_flag("!--no-truncations", o.settings.truncations, "leave out the truncations");
+  cmd.add_flag("!--no-foreign", o.settings.foreign, "leave out the other types' messages");
+  cmd.add_option("--first", o.first, "send from packet number N (see --list)")
+      ->check(CLI::NonNegativeNumber);
+  cmd.add_option("--last", o.last, "send up to packet number N, inclusive");
+  cmd.add_flag("--list", o.list, "print every packet: number, channel, size, how it was made");
+  cmd.add_option("--describe", o.describe, "print packet number N (with --save: write its bytes)");
+  cmd.add_option("--save", o.save, "with --describe: the file to write the packet to");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -205,9 +295,22 @@ int main(int argc, char** argv) {
   verify_cmd->add_option("LOG", log_path, "the LCM log file")->required();
   verify_cmd->add_option("--count", log_count, "messages the log must hold intact (0: any)");
 
+  HostileOptions hostile;
+  CLI::App* hostile_cmd = app.add_subcommand(
+      "hostile", "Publish hostile packets of every type on the channels the system reads");
+  add_hostile_options(*hostile_cmd, hostile);
+
   return sg::run_program(app, argc, argv, [&] {
     const sg::Config config = sg::load_common(common);
     if (*verify_cmd) return run_verify_log(log_path, log_count);
+    if (*hostile_cmd) {
+      sg::bus_check::HostilePlan plan =
+          sg::bus_check::plan_attack(hostile.channels, hostile.settings);
+      if (hostile.list || hostile.describe >= 0) return show_hostile(plan, hostile);
+      sg::install_shutdown_handlers();
+      sg::Bus bus(common.lcm_url);
+      return run_hostile(bus, plan, hostile);
+    }
 
     const sg::bus_check::SendSettings settings = sg::bus_check::read_send_settings(config);
     send.count = settings.count;
