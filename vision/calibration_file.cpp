@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
+#include <fstream>
 #include <opencv2/core.hpp>
 #include <opencv2/core/eigen.hpp>
 
@@ -114,6 +115,14 @@ void write_calibration(const std::string& path, const StereoCalibration& c) {
 }
 
 StereoCalibration read_calibration(const std::string& path) {
+  // Only YAML as write_calibration writes it reaches FileStorage: OpenCV 4.6's XML parser
+  // dereferences NULL on some malformed files (fuzz/calibration_fuzz.cpp found a 43-byte one).
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw CalibrationError(path + ": cannot open calibration file");
+  std::string head(5, '\0');
+  if (!file.read(head.data(), 5) || head != "%YAML") {
+    throw CalibrationError(path + ": not a calibration file (it starts with %YAML:1.0)");
+  }
   cv::FileStorage fs;
   try {
     if (!fs.open(path, cv::FileStorage::READ))

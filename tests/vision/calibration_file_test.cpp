@@ -72,6 +72,10 @@ TEST(CalibrationFile, BadKeysAreNamed) {
   std::ofstream(dir + "/garbage.yaml") << "%YAML:1.0\n---\nthis: [is, not\n";
   EXPECT_THROW(read_calibration(dir + "/garbage.yaml"), CalibrationError);
   EXPECT_THROW(read_calibration(dir + "/absent.yaml"), CalibrationError);
+  // Not YAML: refused before OpenCV's XML parser, which crashed on this (fuzz/calibration_fuzz).
+  std::ofstream(dir + "/crash.xml", std::ios::binary)
+      << std::string("<?xmlSSfffffzfffff\nfffffffff=\0\0\0\0\0\0\0fxmlSSS", 43);
+  EXPECT_THROW(read_calibration(dir + "/crash.xml"), CalibrationError);
 }
 
 // A failed write leaves the good file that was there.
