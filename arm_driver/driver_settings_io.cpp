@@ -37,7 +37,7 @@ ArmDriverSettings read_arm_driver_settings(const Config& config) {
   milliseconds_key(a, "motion_reply_ms", t.motion_reply, "ms for the ACK of a motion command");
   a.number("max_speed", s.driver.max_speed, Range::above_to(0, 1),
            "fastest the driver lets the arm move, fraction of the joints' maximum speeds");
-  a.number("reconnect_max", s.driver.reconnect_max, Range::at_least(s.driver.reconnect_min),
+  a.number("reconnect_max", s.driver.reconnect_max, Range::closed(s.driver.reconnect_min, 3600),
            "s: the reconnect back-off doubles up to this");
   a.done();
   return s;

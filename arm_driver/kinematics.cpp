@@ -280,10 +280,11 @@ double motion_time(const ArmGeometry& geometry, const Joints& from, const Joints
 
 namespace {
 
-/// The list of `n` rows of `width` finite numbers at `key` (which must be present).
+/// The list of `n` rows of `width` numbers at `key` (which must be present), each finite and at
+/// most `bound` in magnitude.
 std::vector<std::vector<double>> read_rows(const sg::Config& config, const std::string& key,
                                            std::size_t n, std::size_t width,
-                                           const std::string& shape) {
+                                           const std::string& shape, double bound) {
   const auto rows = config.require<std::vector<std::vector<double>>>(key);
   if (rows.size() != n) {
     throw config.error_at(key, "expected " + std::to_string(n) + " rows " + shape + ", got " +
@@ -295,51 +296,38 @@ std::vector<std::vector<double>> read_rows(const sg::Config& config, const std::
                                      std::to_string(rows[i].size()) + " numbers");
     }
     for (const double v : rows[i]) {
-      if (!std::isfinite(v)) {
-        throw config.error_at(key, "row " + std::to_string(i + 1) + " holds a non-finite number");
+      if (!sg::Range::closed(-bound, bound).contains(v)) {
+        throw config.error_at(key, "row " + std::to_string(i + 1) + ": every number must be in [" +
+                                       sg::show(-bound) + ", " + sg::show(bound) + "], got " +
+                                       sg::show(v));
       }
     }
   }
   return rows;
 }
 
-/// The list of `n` finite numbers at `key` (which must be present).
-std::vector<double> read_list(const sg::Config& config, const std::string& key, std::size_t n) {
-  const auto values = config.require<std::vector<double>>(key);
-  if (values.size() != n) {
-    throw config.error_at(
-        key, "expected " + std::to_string(n) + " numbers, got " + std::to_string(values.size()));
-  }
-  for (const double v : values) {
-    if (!std::isfinite(v)) throw config.error_at(key, "holds a non-finite number");
-  }
-  return values;
-}
-
-Eigen::Vector3d read_vector3(const sg::Config& config, const std::string& key,
-                             const Eigen::Vector3d& fallback) {
-  if (!config.has(key)) return fallback;
-  const std::vector<double> v = read_list(config, key, 3);
-  return {v[0], v[1], v[2]};
-}
-
 }  // namespace
 
 ArmGeometry load_arm_geometry(const sg::Config& config) {
   ArmGeometry g = ArmGeometry::a465();
-  const auto text = [](const Eigen::Vector3d& v) { return sg::show({v.x(), v.y(), v.z()}); };
   sg::Section arm(config, "arm");
   arm.known("dh", "the A465's", "modified DH rows [alpha_deg, a_m, d_m, theta_offset_deg]");
   arm.known("limits_deg", "the A465's", "joint limits [[min_deg, max_deg] x 6]");
   std::vector<double> speeds_deg;
   for (const DhLink& l : g.links) speeds_deg.push_back(l.max_speed / kRadPerDeg);
-  arm.known("max_speed_deg_s", sg::show(speeds_deg), "joint speed limits, deg/s", 6);
-  arm.known("tool_offset", text(g.tool.translation()), "TCP in the flange frame, m", 3);
-  arm.known("workspace_min", text(g.workspace.min), "the workspace's lower corner, m", 3);
-  arm.known("workspace_max", text(g.workspace.max), "the workspace's upper corner, m", 3);
+  arm.numbers("max_speed_deg_s", speeds_deg.data(), 6, sg::Range::above_to(0, 3600),
+              "joint speed limits, deg/s");
+  Eigen::Vector3d tool = g.tool.translation();
+  arm.numbers("tool_offset", tool.data(), 3, sg::Range::closed(-2, 2),
+              "TCP in the flange frame, m");
+  arm.numbers("workspace_min", g.workspace.min.data(), 3, sg::Range::closed(-10, 10),
+              "the workspace's lower corner, m");
+  arm.numbers("workspace_max", g.workspace.max.data(), 3, sg::Range::closed(-10, 10),
+              "the workspace's upper corner, m");
   arm.done();
   if (config.has("arm.dh")) {
-    const auto rows = read_rows(config, "arm.dh", 6, 4, "[alpha_deg, a_m, d_m, theta_offset_deg]");
+    const auto rows =
+        read_rows(config, "arm.dh", 6, 4, "[alpha_deg, a_m, d_m, theta_offset_deg]", 360);
     for (int i = 0; i < 6; ++i) {
       DhLink& l = g.links[i];
       l.alpha = rows[i][0] * kRadPerDeg, l.a = rows[i][1], l.d = rows[i][2];
@@ -349,7 +337,7 @@ ArmGeometry load_arm_geometry(const sg::Config& config) {
     if (!problem.empty()) throw config.error_at("arm.dh", problem);
   }
   if (config.has("arm.limits_deg")) {
-    const auto rows = read_rows(config, "arm.limits_deg", 6, 2, "[min_deg, max_deg]");
+    const auto rows = read_rows(config, "arm.limits_deg", 6, 2, "[min_deg, max_deg]", 360);
     for (int i = 0; i < 6; ++i) {
       if (!(rows[i][0] < rows[i][1])) {
         throw config.error_at("arm.limits_deg",
@@ -358,19 +346,8 @@ ArmGeometry load_arm_geometry(const sg::Config& config) {
       g.links[i].min = rows[i][0] * kRadPerDeg, g.links[i].max = rows[i][1] * kRadPerDeg;
     }
   }
-  if (config.has("arm.max_speed_deg_s")) {
-    const auto speeds = read_list(config, "arm.max_speed_deg_s", 6);
-    for (int i = 0; i < 6; ++i) {
-      if (!(speeds[i] > 0)) {
-        throw config.error_at("arm.max_speed_deg_s",
-                              "joint " + std::to_string(i + 1) + ": speed must be positive");
-      }
-      g.links[i].max_speed = speeds[i] * kRadPerDeg;
-    }
-  }
-  g.tool = Eigen::Translation3d(read_vector3(config, "arm.tool_offset", g.tool.translation()));
-  g.workspace.min = read_vector3(config, "arm.workspace_min", g.workspace.min);
-  g.workspace.max = read_vector3(config, "arm.workspace_max", g.workspace.max);
+  for (int i = 0; i < 6; ++i) g.links[i].max_speed = speeds_deg[i] * kRadPerDeg;
+  g.tool = Eigen::Translation3d(tool);
   if (!(g.workspace.min.array() < g.workspace.max.array()).all()) {
     throw config.error_at(
         config.has("arm.workspace_max") ? "arm.workspace_max" : "arm.workspace_min",

@@ -20,8 +20,8 @@ namespace sg::bus_check {
 SendSettings read_send_settings(const Config& config) {
   SendSettings s;
   Section c(config, "bus_check");
-  c.number("count", s.count, Range::at_least(0), "messages to send, 0 for no limit");
-  c.number("rate_hz", s.rate_hz, Range::above(0), "messages per second");
+  c.number("count", s.count, Range::closed(0, 1e9), "messages to send, 0 for no limit");
+  c.number("rate_hz", s.rate_hz, Range::above_to(0, 1e6), "messages per second");
   c.done();
   return s;
 }

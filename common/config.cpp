@@ -158,8 +158,15 @@ void Config::reject_unknown_keys(const std::string& section,
 }
 
 void Config::declare(const KeyInfo& info) const {
-  for (const KeyInfo& k : *declared_) {
-    if (k.key == info.key) return;
+  for (KeyInfo& k : *declared_) {
+    if (k.key != info.key) continue;
+    // Named first by known() (for its help text), then read with a range: keep the text, take
+    // the kind and the range.
+    if (k.kind == KeyKind::kTable && info.kind != KeyKind::kTable) {
+      k.kind = info.kind, k.range = info.range, k.options = info.options;
+      if (k.requirement.empty()) k.requirement = info.requirement;
+    }
+    return;
   }
   declared_->push_back(info);
 }
@@ -172,17 +179,18 @@ std::string Config::location(const std::string& key, const YAML::Node& node) con
 Section::Section(const Config& config, std::string name)
     : config_(config), name_(std::move(name)) {}
 
-void Section::declare(const std::string& key, const std::string& default_text,
-                      const std::string& requirement, const std::string& help, int arity) {
-  keys_.push_back(key);
-  config_.declare({name_ + "." + key, default_text, requirement, help, arity});
+void Section::declare(KeyInfo info) {
+  keys_.push_back(info.key);
+  info.key = name_ + "." + info.key;
+  config_.declare(info);
 }
 
 void Section::numbers(const std::string& key, double* values, int n, const Range& range,
                       const std::string& help) {
   const std::vector<double> fallback(values, values + n);
   const std::string each = range.requirement().substr(std::string("must be ").size());
-  declare(key, show(fallback), "must be " + std::to_string(n) + " numbers, each " + each, help, n);
+  declare({key, show(fallback), "must be " + std::to_string(n) + " numbers, each " + each, help, n,
+           KeyKind::kNumbers, range, {}});
   const std::string full = name_ + "." + key;
   if (!config_.has(full)) return;
   const auto v = config_.require<std::vector<double>>(full);
@@ -200,7 +208,7 @@ void Section::numbers(const std::string& key, double* values, int n, const Range
 }
 
 void Section::text(const std::string& key, std::string& value, const std::string& help) {
-  declare(key, value.empty() ? "\"\"" : value, "", help, 1);
+  declare({key, value.empty() ? "\"\"" : value, "", help, 1, KeyKind::kText, {}, {}});
   value = config_.get<std::string>(name_ + "." + key, value);
 }
 
@@ -208,7 +216,7 @@ void Section::choice(const std::string& key, std::string& value,
                      const std::vector<std::string>& options, const std::string& help) {
   std::string list;
   for (const std::string& o : options) list += (list.empty() ? "" : ", ") + o;
-  declare(key, value, "must be one of " + list, help, 1);
+  declare({key, value, "must be one of " + list, help, 1, KeyKind::kChoice, {}, options});
   const std::string full = name_ + "." + key;
   const std::string v = config_.get<std::string>(full, value);
   if (std::find(options.begin(), options.end(), v) == options.end())
@@ -217,7 +225,7 @@ void Section::choice(const std::string& key, std::string& value,
 }
 
 void Section::flag(const std::string& key, bool& value, const std::string& help) {
-  declare(key, value ? "true" : "false", "", help, 1);
+  declare({key, value ? "true" : "false", "", help, 1, KeyKind::kFlag, {}, {}});
   value = config_.get<bool>(name_ + "." + key, value);
 }
 

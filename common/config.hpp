@@ -40,13 +40,29 @@ struct Range {
   std::string requirement() const;
 };
 
-/// What a settings reader says about one key: for `--help`, and for suggestions.
+/// What kind of value a key holds, as its reader declares it.
+enum class KeyKind {
+  kNumber,   ///< a real number in `range`
+  kInteger,  ///< an integer in `range`
+  kNumbers,  ///< a list of `arity` real numbers, each in `range`
+  kText,     ///< any string (a path, a URL)
+  kChoice,   ///< one of `options`
+  kFlag,     ///< true or false
+  kTable,    ///< read and checked by the reader itself (a list of rows, say)
+};
+
+/// What a settings reader says about one key: for `--help`, for suggestions, and for the tests
+/// that drive every key with NaN, infinities and values out of its range
+/// (tests/common/config_ranges_test.cpp).
 struct KeyInfo {
   std::string key;           ///< dotted: `grasp.standoff`
   std::string default_text;  ///< the settings struct's default, as text
   std::string requirement;   ///< "must be in [0, 0.5]" ("" when any value of its type goes)
   std::string help;          ///< what it means, with its unit
   int arity = 1;             ///< values a flag for it takes (a list of 3: 3)
+  KeyKind kind = KeyKind::kTable;
+  Range range;                       ///< kNumber, kInteger, kNumbers: the values accepted
+  std::vector<std::string> options;  ///< kChoice: the values accepted
 };
 
 /// The key nearest to `word` by edit distance (Levenshtein), "" when `candidates` is empty.
@@ -186,7 +202,8 @@ class Section {
   template <class T>
   void number(const std::string& key, T& value, const Range& range, const std::string& help) {
     static_assert(std::is_arithmetic_v<T> && !std::is_same_v<T, bool>);
-    declare(key, show(static_cast<double>(value)), range.requirement(), help, 1);
+    declare({key, show(static_cast<double>(value)), range.requirement(), help, 1,
+             std::is_integral_v<T> ? KeyKind::kInteger : KeyKind::kNumber, range, {}});
     const std::string full = name_ + "." + key;
     if (!config_.has(full)) return;
     const T v = config_.get<T>(full, value);
@@ -209,7 +226,7 @@ class Section {
   template <class T>
   bool read(const std::string& key, T& value, const std::string& default_text,
             const std::string& help, int arity = 1) {
-    declare(key, default_text, "", help, arity);
+    declare({key, default_text, "", help, arity, KeyKind::kTable, {}, {}});
     const std::string full = name_ + "." + key;
     if (!config_.has(full)) return false;
     value = config_.require<T>(full);
@@ -219,7 +236,7 @@ class Section {
   /// Names a key the caller reads itself (a table, say); true when it is present.
   bool known(const std::string& key, const std::string& default_text, const std::string& help,
              int arity = 0) {
-    declare(key, default_text, "", help, arity);
+    declare({key, default_text, "", help, arity, KeyKind::kTable, {}, {}});
     return config_.has(name_ + "." + key);
   }
 
@@ -231,8 +248,8 @@ class Section {
   void done() const { config_.reject_unknown_keys(name_, keys_); }
 
  private:
-  void declare(const std::string& key, const std::string& default_text,
-               const std::string& requirement, const std::string& help, int arity);
+  /// Declares `info`, whose `key` is the leaf name (the section's name is prefixed).
+  void declare(KeyInfo info);
 
   const Config& config_;
   std::string name_;

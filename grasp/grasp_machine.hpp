@@ -209,6 +209,14 @@ struct ArmRequest {
   int64_t target_utime = 0;  ///< interception time T (0 when none)
 };
 
+/// What sg-grasp accepts on its inputs besides well-formed messages (grasp_messages.hpp
+/// check_trajectory): every point inside the arm's workspace widened by `margin`, and times
+/// within `max_time_offset` of the receiver's clock.
+struct InputGate {
+  double margin = 0.25;          ///< m beyond geometry.workspace on every side
+  double max_time_offset = 5.0;  ///< s between a message's times and now (0: not checked)
+};
+
 struct GraspSettings {
   double standoff = 0.10;           ///< m above the ball while tracking
   double lift = 0.15;               ///< m the object is lifted (a3)
@@ -220,6 +228,7 @@ struct GraspSettings {
   double default_delay = 0.78;  ///< s per controller command until one is measured
   bool use_prediction = true;   ///< false: aim at the last measurement (PredictedPath::hold)
   InterceptionSettings interception;
+  InputGate input_gate;
 };
 
 /// What GRASP_STATUS shows.

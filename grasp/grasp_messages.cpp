@@ -1,6 +1,7 @@
 #include "grasp/grasp_messages.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 namespace sg::grasp {
 
@@ -50,8 +51,14 @@ stereograsp::grasp_status_t to_grasp_status(const GraspStatusView& v, int64_t ut
   return m;
 }
 
-std::optional<PredictedPath> path_from(const stereograsp::trajectory_t& m, std::string* why) {
-  const auto refuse = [&](const std::string& reason) -> std::optional<PredictedPath> {
+namespace {
+
+/// path_from(), with the kind of refusal in `kind`.
+std::optional<PredictedPath> convert(const stereograsp::trajectory_t& m, TrajectoryRefusal* kind,
+                                     std::string* why) {
+  const auto refuse = [&](TrajectoryRefusal k,
+                          const std::string& reason) -> std::optional<PredictedPath> {
+    *kind = k;
     if (why) *why = reason;
     return std::nullopt;
   };
@@ -60,9 +67,12 @@ std::optional<PredictedPath> path_from(const stereograsp::trajectory_t& m, std::
   p.start_utime = m.start_utime;
   p.period_us = m.period_us;
   p.lost = m.status == stereograsp::trajectory_t::STATUS_LOST;
-  if (m.period_us <= 0) return refuse("period " + std::to_string(m.period_us) + " us");
+  if (m.period_us <= 0) {
+    return refuse(TrajectoryRefusal::kBadPeriod, "period " + std::to_string(m.period_us) + " us");
+  }
   if (m.num_points < 0 || static_cast<size_t>(m.num_points) != m.position.size()) {
-    return refuse("num_points " + std::to_string(m.num_points) + " for " +
+    return refuse(TrajectoryRefusal::kMalformed, "num_points " + std::to_string(m.num_points) +
+                                                     " for " +
                   std::to_string(m.position.size()) + " points");
   }
   for (const auto& q : m.position) {
@@ -71,10 +81,104 @@ std::optional<PredictedPath> path_from(const stereograsp::trajectory_t& m, std::
     } else if (p.lost) {
       break;  // a lost track may carry NaNs
     } else {
-      return refuse("point " + std::to_string(p.points.size()) + " is not 3 finite numbers");
+      return refuse(TrajectoryRefusal::kNonFinite,
+                    "point " + std::to_string(p.points.size()) + " is not 3 finite numbers");
     }
   }
   return p;
+}
+
+}  // namespace
+
+std::optional<PredictedPath> path_from(const stereograsp::trajectory_t& m, std::string* why) {
+  TrajectoryRefusal kind;
+  return convert(m, &kind, why);
+}
+
+const char* to_string(TrajectoryRefusal reason) {
+  switch (reason) {
+    case TrajectoryRefusal::kMalformed:
+      return "malformed";
+    case TrajectoryRefusal::kNonFinite:
+      return "non-finite";
+    case TrajectoryRefusal::kOutsideWorkspace:
+      return "outside the workspace";
+    case TrajectoryRefusal::kBadPeriod:
+      return "bad period";
+    case TrajectoryRefusal::kTooManyPoints:
+      return "too many points";
+    case TrajectoryRefusal::kTimeFarFromNow:
+      return "time far from now";
+  }
+  return "?";
+}
+
+namespace {
+
+std::string xyz(const Eigen::Vector3d& p) {
+  char text[96];
+  std::snprintf(text, sizeof text, "(%.4g, %.4g, %.4g)", p.x(), p.y(), p.z());
+  return text;
+}
+
+/// "" when `t` (a message time, us) is plausible at `now`, else why not.
+std::string time_problem(const char* name, int64_t t, int64_t now, double max_offset) {
+  const double offset = (static_cast<double>(t) - static_cast<double>(now)) * 1e-6;
+  if (t <= 0 || t > kLatestUtime) return std::string(name) + " " + std::to_string(t) + " us";
+  if (max_offset > 0 && !(std::abs(offset) <= max_offset)) {
+    return std::string(name) + " is " + std::to_string(offset) + " s from the receiver's clock";
+  }
+  return "";
+}
+
+/// The checks before path_from(): the ones that bound what path_from() walks and computes.
+std::optional<std::pair<TrajectoryRefusal, std::string>> header_problem(
+    const stereograsp::trajectory_t& m, const InputGate& gate, int64_t now) {
+  using R = TrajectoryRefusal;
+  if (m.period_us < kMinPeriodUs || m.period_us > kMaxPeriodUs) {
+    return std::pair{R::kBadPeriod, "period " + std::to_string(m.period_us) + " us (1 ms to 60 s)"};
+  }
+  if (m.num_points > kMaxTrajectoryPoints) {
+    return std::pair{R::kTooManyPoints, "num_points " + std::to_string(m.num_points) +
+                                            " (at most " +
+                                            std::to_string(kMaxTrajectoryPoints) + ")"};
+  }
+  for (const auto& [name, t] : {std::pair{"utime", m.utime}, {"start_utime", m.start_utime}}) {
+    if (std::string p = time_problem(name, t, now, gate.max_time_offset); !p.empty()) {
+      return std::pair{R::kTimeFarFromNow, std::move(p)};
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+TrajectoryCheck check_trajectory(const stereograsp::trajectory_t& m,
+                                 const arm::Workspace& workspace, const InputGate& gate,
+                                 int64_t now) {
+  TrajectoryCheck c;
+  if (auto problem = header_problem(m, gate, now)) {
+    c.reason = problem->first, c.why = std::move(problem->second);
+    return c;
+  }
+  std::optional<PredictedPath> path = convert(m, &c.reason, &c.why);
+  if (!path) return c;
+  if (!path->lost) {
+    const Eigen::Vector3d lo = workspace.min.array() - gate.margin;
+    const Eigen::Vector3d hi = workspace.max.array() + gate.margin;
+    for (size_t i = 0; i < path->points.size(); ++i) {
+      const Eigen::Vector3d& q = path->points[i];
+      if (!((q.array() >= lo.array()).all() && (q.array() <= hi.array()).all())) {
+        c.reason = TrajectoryRefusal::kOutsideWorkspace;
+        c.why = "point " + std::to_string(i) + " " + xyz(q) + " m outside the workspace " +
+                xyz(lo) + " .. " + xyz(hi) + " m";
+        return c;
+      }
+    }
+  }
+  c.path = std::move(path);
+  c.why.clear();
+  return c;
 }
 
 }  // namespace sg::grasp

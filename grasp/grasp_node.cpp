@@ -20,16 +20,37 @@ std::string ascii(const std::string& text, std::size_t limit) {
 
 GraspNode::GraspNode(ArmGeometry geometry, GraspSettings settings, int64_t first_sequence,
                      double status_period)
-    : machine_(std::move(geometry), std::move(settings), first_sequence),
+    : workspace_(geometry.workspace),
+      gate_(settings.input_gate),
+      machine_(std::move(geometry), std::move(settings), first_sequence),
       status_rule_(status_period) {}
 
 std::string GraspNode::on_trajectory(const stereograsp::trajectory_t& trajectory, int64_t now) {
+  TrajectoryCheck c = check_trajectory(trajectory, workspace_, gate_, now);
+  if (!c.path) {
+    ++refused_[static_cast<size_t>(c.reason)];
+    last_refusal_ = ascii(c.why, kMaxReason);
+    refusals_changed_ = true;
+    return c.why;
+  }
   trajectory_utime_ = trajectory.utime;
-  std::string why;
-  std::optional<PredictedPath> path = path_from(trajectory, &why);
-  if (!path) return why;
-  machine_.on_trajectory(*path, trajectory.source_utime, now);
+  machine_.on_trajectory(*c.path, trajectory.source_utime, now);
   return "";
+}
+
+std::string GraspNode::refusal_note() const {
+  uint64_t total = 0;
+  std::string each;
+  for (int i = 0; i < kTrajectoryRefusals; ++i) {
+    const uint64_t n = refused_[static_cast<size_t>(i)];
+    if (n == 0) continue;
+    total += n;
+    each += (each.empty() ? "" : ", ") + std::string(to_string(static_cast<TrajectoryRefusal>(i))) +
+            " " + std::to_string(n);
+  }
+  if (total == 0) return "";
+  return "OBJECT_TRAJECTORY refused " + std::to_string(total) + " (" + each +
+         "); last: " + last_refusal_;
 }
 
 void GraspNode::on_position(const stereograsp::point3_t& m) {
@@ -91,11 +112,23 @@ GraspNode::Output GraspNode::poll(int64_t now) {
   if (std::optional<ArmRequest> request = machine_.take_request(now)) {
     out.arm_command = to_arm_cmd(*request, trajectory_utime_ ? trajectory_utime_ : now);
   }
-  const std::string s = summary(machine_.status());
+  // The refusal note changes at most once per kRefusalNotePeriod (or when the clock went back).
+  if (refusals_changed_ && (now - note_utime_ >= static_cast<int64_t>(kRefusalNotePeriod * 1e6) ||
+                            now < note_utime_)) {
+    note_ = refusal_note();
+    note_utime_ = now;
+    refusals_changed_ = false;
+  }
+  const std::string s =
+      summary(machine_.status()) + (note_.empty() ? "" : " [" + note_ + "]");
   const bool changed = s != last_summary_;
   if (changed || command_changed_) ++status_version_;
   if (status_rule_.due(status_version_, static_cast<double>(now) * 1e-6)) {
     out.status = to_grasp_status(machine_.status(), now, command_);
+    if (!note_.empty()) {
+      std::string& message = out.status->message;
+      message += (message.empty() ? "" : "; ") + note_;
+    }
     if (changed) out.changed_summary = s;
     last_summary_ = s;
     command_changed_ = false;

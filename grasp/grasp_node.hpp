@@ -12,6 +12,11 @@
 ///     goes out on the next GRASP_STATUS (command_sequence, command_result, command_reason).
 ///     The last sequence of at most kMaxSenders senders is kept (the longest silent is forgotten
 ///     first), so no stream of made-up senders exhausts the process.
+///   - OBJECT_TRAJECTORY: refused (counted by reason, never turned into a target) when it fails
+///     check_trajectory(): malformed, non-finite, a point outside the workspace plus
+///     settings.input_gate.margin, a bad period, too many points, times far from `now`. The
+///     counts and the newest reason ride on GRASP_STATUS's message, updated at most once per
+///     kRefusalNotePeriod so a flood of bad trajectories cannot flood GRASP_STATUS.
 ///   - ARM_COMMAND: at most one per poll(), the machine's take_request(now); its utime is the
 ///     newest trajectory's utime (the decision's message time), `now` before any trajectory.
 ///   - GRASP_STATUS: when the summary (state, activity, last action, outcome, message) or the
@@ -24,6 +29,7 @@
 ///     if (out.arm_command) bus.publish("ARM_COMMAND", *out.arm_command);
 ///     if (out.status) bus.publish("GRASP_STATUS", *out.status);
 
+#include <array>
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -49,6 +55,8 @@ class GraspNode {
   static constexpr std::size_t kMaxReason = 200;
   /// The largest stand-off a GRASP_COMMAND may ask for, m.
   static constexpr double kMaxStandoff = 0.5;
+  /// Seconds between updates of the refusal note on GRASP_STATUS's message.
+  static constexpr double kRefusalNotePeriod = 1.0;
 
   /// What to publish now.
   struct Output {
@@ -63,8 +71,14 @@ class GraspNode {
             double status_period);
 
   /// An OBJECT_TRAJECTORY received at `now`. Returns "" when the machine took it, else why it
-  /// was ignored (a malformed one; path_from()).
+  /// was refused (check_trajectory(); counted in refused_trajectories()).
   std::string on_trajectory(const stereograsp::trajectory_t& trajectory, int64_t now);
+  /// OBJECT_TRAJECTORY refused for `reason` so far.
+  uint64_t refused_trajectories(TrajectoryRefusal reason) const {
+    return refused_[static_cast<size_t>(reason)];
+  }
+  /// "OBJECT_TRAJECTORY refused 3 (non-finite 2, time far from now 1); last: <why>", "" if none.
+  std::string refusal_note() const;
 
   /// An OBJECT_POSITION: the measurement at its utime (not visible or not finite: none).
   void on_position(const stereograsp::point3_t& position);
@@ -98,6 +112,8 @@ class GraspNode {
   /// Checks `command`'s sequence against its sender's last; true when newer (or first).
   bool newer(const stereograsp::grasp_command_t& command, int64_t now, std::string* why);
 
+  arm::Workspace workspace_;  ///< the arm's, for the trajectory gate (before machine_ takes it)
+  InputGate gate_;
   GraspMachine machine_;
   ChangeOrPeriod status_rule_;  ///< GRASP_STATUS on a change, else once a period
   uint64_t status_version_ = 0;  ///< counts the changes of the summary and the command answer
@@ -106,6 +122,11 @@ class GraspNode {
   CommandRecord command_;
   bool command_changed_ = false;
   std::string last_summary_;
+  std::array<uint64_t, kTrajectoryRefusals> refused_{};
+  std::string last_refusal_;
+  bool refusals_changed_ = false;
+  std::string note_;            ///< refusal_note() as last put on GRASP_STATUS
+  int64_t note_utime_ = 0;      ///< when note_ was updated
 };
 
 }  // namespace sg::grasp

@@ -11,23 +11,30 @@ GraspSettings read_grasp_settings(const Config& config) {
   g.number("backoff", s.backoff, Range::closed(0, 0.5),
            "m the tool rises when the track is lost during an approach");
   g.number("speed", s.speed, Range::above_to(0, 1), "fraction of the joint speed limits");
-  g.number("max_trajectory_age", s.max_trajectory_age, Range::above(0),
+  g.number("max_trajectory_age", s.max_trajectory_age, Range::above_to(0, 60),
            "s: an older OBJECT_TRAJECTORY gives no command");
-  g.number("success_distance", s.success_distance, Range::above(0),
+  g.number("success_distance", s.success_distance, Range::above_to(0, 1),
            "m: after the lift, the measured ball this close to the tool = held");
-  g.number("judge_time", s.judge_time, Range::above(0),
+  g.number("judge_time", s.judge_time, Range::above_to(0, 60),
            "s after the arm stops: no sighting that close by then = not held");
-  g.number("default_delay", s.default_delay, Range::above(0),
+  g.number("default_delay", s.default_delay, Range::above_to(0, 10),
            "s per controller command until ARM_STATUS has measured one");
   g.flag("use_prediction", s.use_prediction,
          "false: aim at the last measured position (the baseline)");
-  g.number("table_z", i.table_z, Range::finite(), "m: the table top in the robot's frame");
-  g.number("table_margin", i.table_margin, Range::at_least(0),
+  g.number("table_z", i.table_z, Range::closed(-2, 2), "m: the table top in the robot's frame");
+  g.number("table_margin", i.table_margin, Range::closed(0, 0.5),
            "m the tool centre point stays above the table");
-  g.number("wrist_min", i.wrist_min, Range::above(0),
+  g.number("wrist_min", i.wrist_min, Range::above_to(0, 2),
            "m: the approach leans so the wrist centre stays this far from the shoulder ...");
-  g.number("wrist_max", i.wrist_max, Range::above(0), "m: ... and no farther");
+  g.number("wrist_max", i.wrist_max, Range::above_to(0, 2), "m: ... and no farther");
   if (!(i.wrist_min < i.wrist_max)) throw g.error("wrist_min", "must be below wrist_max");
+  InputGate& in = s.input_gate;
+  g.number("position_margin", in.margin, Range::closed(0, 2),
+           "m: an OBJECT_TRAJECTORY point farther than this outside the arm's workspace "
+           "(arm.workspace_min/max) refuses the trajectory");
+  g.number("max_time_offset", in.max_time_offset, Range::closed(0, 3600),
+           "s: an OBJECT_TRAJECTORY whose utime or start_utime is farther than this from the "
+           "receiver's clock is refused (0: not checked, for replays of old logs)");
   g.done();
   return s;
 }

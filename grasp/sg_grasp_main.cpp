@@ -33,7 +33,7 @@ int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
   sg::grasp::GraspNode node(geometry, settings, sg::now_utime(), 1.0 / status_rate);
   bus.subscribe<stereograsp::trajectory_t>("OBJECT_TRAJECTORY", [&](const auto& m, const auto&) {
     const std::string why = node.on_trajectory(m, sg::now_utime());
-    if (!why.empty()) spdlog::warn("OBJECT_TRAJECTORY at {}: {}; ignored", m.utime, why);
+    if (!why.empty()) bus.note_refused("OBJECT_TRAJECTORY", why);  // counted, logged sparingly
   });
   bus.subscribe<stereograsp::point3_t>("OBJECT_POSITION",
                                        [&](const auto& m, const auto&) { node.on_position(m); });

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "arm_driver/kinematics.hpp"
+
 namespace sg::predictor {
 namespace {
 
@@ -24,28 +26,41 @@ PredictorSettings read_predictor_settings(const Config& config) {
   c.choice("model", model, {"burg", "kalman", "hold"}, "burg, or the baselines kalman and hold");
   p.model = model_from_name(model);
   seconds_key(c, "period", p.period_us, Range::closed(0.001, 60), "s: the sample period");
-  c.number("horizon", p.horizon, Range::closed(1, 100000), "samples forecast H");
-  c.number("max_gap", p.max_gap, Range::closed(0, 100000),
+  c.number("horizon", p.horizon, Range::closed(1, kMaxHorizon), "samples forecast H");
+  c.number("max_gap", p.max_gap, Range::closed(0, 10000),
            "fed-back samples through an occlusion before the track is lost");
-  c.number("order", p.burg.order, Range::closed(1, 1000), "Burg's order p");
-  c.number("window", p.burg.window, Range::closed(4, 1000000), "samples in the sliding window W");
+  c.number("order", p.burg.order, Range::closed(1, 100), "Burg's order p");
+  c.number("window", p.burg.window, Range::closed(4, 100000), "samples in the sliding window W");
   if (p.burg.window < p.burg.order + 3) throw c.error("window", "must exceed the order by 3");
   c.flag("remove_mean", p.burg.remove_mean, "Burg models a zero-mean signal");
   c.text("coefficients", s.coefficients,
          "offline-trained coefficients (sg-predictor train); \"\" = learn online");
-  c.number("online_after", p.burg.online_after, Range::at_least(0),
+  c.number("online_after", p.burg.online_after, Range::closed(0, 100000),
            "with coefficients: samples before online estimates replace them");
   if (p.burg.online_after > p.burg.window)
     throw c.error("online_after", "must be 0 to the window's length");
-  c.number("gate", p.gate, Range::at_least(0),
+  c.number("gate", p.gate, Range::closed(0, 10),
            "m: while tracking, a measurement this far from the forecast is taken as not seen "
            "(0: off)");
-  seconds_key(c, "gate_patience", p.gate_patience_us, Range::at_least(0),
+  seconds_key(c, "gate_patience", p.gate_patience_us, Range::closed(0, 600),
               "s: ... unless measurements disagree for this long");
-  c.number("kalman_q", p.kalman.q, Range::above(0),
+  c.number("kalman_q", p.kalman.q, Range::above_to(0, 1e3),
            "kalman: white-acceleration spectral density (m^2/s^3)");
-  c.number("kalman_r", p.kalman.r, Range::above(0), "kalman: measurement noise (m)");
+  c.number("kalman_r", p.kalman.r, Range::above_to(0, 10), "kalman: measurement noise (m)");
+  c.number("reset_distance", p.reset_distance, Range::closed(0.1, 1000),
+           "m: a sample this far from the base, or a forecast point this far from the newest "
+           "sample (or not finite), resets the predictor");
+  PositionGateParams& g = s.gate;
+  c.number("position_margin", g.margin, Range::closed(0, 2),
+           "m: an OBJECT_POSITION farther than this outside the arm's workspace "
+           "(arm.workspace_min/max) is refused");
+  seconds_key(c, "max_time_offset", g.max_time_offset_us, Range::closed(0, 3600),
+              "s: an OBJECT_POSITION whose capture time is farther than this from the receiver's "
+              "clock is refused (0: not checked, for replays of old logs)");
   c.done();
+  const arm::Workspace workspace = arm::load_arm_geometry(config).workspace;
+  g.box_min = workspace.min;
+  g.box_max = workspace.max;
   return s;
 }
 

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "common/config.hpp"
+#include "predictor/position_gate.hpp"
 #include "predictor/trajectory_predictor.hpp"
 
 namespace sg::predictor {
@@ -11,10 +12,12 @@ namespace sg::predictor {
 struct PredictorSettings {
   PredictorParams params;
   std::string coefficients;  ///< an offline-trained coefficients file; "" = learn online
+  PositionGateParams gate;   ///< what OBJECT_POSITION must be to reach the predictor
 };
 
 /// Reads the `predictor` section: every key range-checked, any other key of the section refused
-/// with the nearest known one. Absent keys keep PredictorParams' defaults.
+/// with the nearest known one. Absent keys keep PredictorParams' defaults. The gate's box is the
+/// arm's workspace, read from the `arm` section (arm::load_arm_geometry, its one definition).
 PredictorSettings read_predictor_settings(const Config& config);
 
 /// Reads a coefficients file that `sg-predictor train` wrote (order, coefficients.x/y/z) into

@@ -1,7 +1,9 @@
 // sg-predictor: the paper's trajectory prediction (section 5.5). Subscribes to OBJECT_POSITION and
 // publishes OBJECT_TRAJECTORY (H points on a fixed period) for every new sample; carries the
 // track through occlusions by feeding predictions back. Time comes only from the messages, so a
-// replayed log gives the same trajectories.
+// replayed log gives the same trajectories. Positions that are not finite, outside the arm's
+// workspace plus a margin, or captured far from the receiver's clock are refused and counted
+// (docs/prediction.md; --max-time-offset 0 for replays of old logs).
 //
 //   sg-predictor                                    # Burg, p = 12, W = 480, 4 Hz, H = 16
 //   sg-predictor --model kalman                     # or hold: the baselines
@@ -11,49 +13,58 @@
 
 #include <spdlog/spdlog.h>
 
+#include <chrono>
 #include <cstdio>
 
 #include "common/bus.hpp"
+#include "common/clock.hpp"
 #include "common/message_types.hpp"
 #include "common/program.hpp"
 #include "common/shutdown.hpp"
 #include "predictor/offline_training.hpp"
+#include "predictor/predictor_node.hpp"
 #include "predictor/predictor_settings.hpp"
 #include "predictor/trajectory_message.hpp"
 #include "predictor/trajectory_predictor.hpp"
 
 namespace {
 
-using sg::predictor::Forecast;
 using sg::predictor::PredictorParams;
 
-int run(const std::string& url, const PredictorParams& params) {
+/// Seconds between the status lines that report new refusals.
+constexpr double kStatusPeriod = 10.0;
+
+int run(const std::string& url, const sg::predictor::PredictorSettings& settings) {
   sg::install_shutdown_handlers();
   sg::Bus bus(url);
-  sg::predictor::TrajectoryPredictor predictor(params);
-  uint64_t published = 0;
+  bus.announce("sg-predictor");  // PROCESS_STATUS: the refusals counted with note_refused()
+  sg::Clock& clock = sg::system_clock();
+  sg::predictor::PredictorNode node(settings, clock);
   bus.subscribe<stereograsp::point3_t>(
       "OBJECT_POSITION", [&](const stereograsp::point3_t& m, const auto&) {
-        const uint64_t rejected = predictor.rejected();
-        const auto forecasts = predictor.add(sg::predictor::measurement_of(m));
-        if (predictor.rejected() > rejected &&
-            (predictor.rejected() <= 10 || predictor.rejected() % 1000 == 0)) {
-          spdlog::warn(
-              "OBJECT_POSITION at utime {}: rejected (non-finite, or time not after the last) ({} "
-              "so far)",
-              m.utime, predictor.rejected());
-        }
-        for (const Forecast& f : forecasts) {
-          bus.publish("OBJECT_TRAJECTORY", sg::predictor::to_trajectory_t(f, params));
-          ++published;
-        }
+        const sg::predictor::PredictorNode::Output out = node.on_position(m);
+        if (!out.refused.empty()) bus.note_refused("OBJECT_POSITION", out.refused);
+        if (!out.reset.empty()) spdlog::warn("predictor reset itself: {}", out.reset);
+        for (const auto& t : out.trajectories) bus.publish("OBJECT_TRAJECTORY", t);
       });
+  const PredictorParams& params = settings.params;
   spdlog::info("predicting with {} (period {} ms, horizon {})",
                sg::predictor::model_name(params.model), params.period_us / 1000, params.horizon);
-  bus.spin();
-  std::printf("published %llu trajectories; %llu measurements rejected\n",
-              static_cast<unsigned long long>(published),
-              static_cast<unsigned long long>(predictor.rejected()));
+  std::string reported = node.status_line();
+  double next_report = clock.now() + kStatusPeriod;
+  bus.spin([&] {  // the refusals by reason, when they changed, at most every kStatusPeriod
+    if (clock.now() < next_report) return true;
+    next_report = clock.now() + kStatusPeriod;
+    if (const std::string line = node.status_line(); line != reported) {
+      spdlog::warn("{}", line);
+      reported = line;
+    }
+    return true;
+  });
+  std::printf("published %llu trajectories; %llu measurements rejected\n%s\n",
+              static_cast<unsigned long long>(node.published()),
+              static_cast<unsigned long long>(node.gate().refused() + node.predictor().rejected()),
+              node.status_line().c_str());
   return 0;
 }
 
@@ -97,6 +108,7 @@ int main(int argc, char** argv) {
   common.flags.add(app, "--order", "predictor.order", keys);
   common.flags.add(app, "--window", "predictor.window", keys);
   common.flags.add(app, "--horizon", "predictor.horizon", keys);
+  common.flags.add(app, "--max-time-offset", "predictor.max_time_offset", keys);
   std::string input, out, channel = "OBJECT_POSITION";
   CLI::App* train_cmd =
       app.add_subcommand("train", "Train Burg coefficients offline from a log or a CSV");
@@ -110,6 +122,6 @@ int main(int argc, char** argv) {
     if (*train_cmd) return train(input, channel, settings.params, out);
     if (!settings.coefficients.empty())
       sg::predictor::read_coefficients(settings.coefficients, settings.params);
-    return run(common.lcm_url, settings.params);
+    return run(common.lcm_url, settings);
   });
 }

@@ -111,12 +111,51 @@ bool TrajectoryPredictor::outside_gate(const Measurement& m) {
   return true;
 }
 
+std::string TrajectoryPredictor::insane(const Forecast& f) const {
+  const double limit = params_.reset_distance;
+  if (!f.sample.allFinite() || !(f.sample.norm() <= limit)) {
+    return "sample (" + std::to_string(f.sample.x()) + ", " + std::to_string(f.sample.y()) + ", " +
+           std::to_string(f.sample.z()) + ") m is not within " + std::to_string(limit) +
+           " m of the base";
+  }
+  for (size_t h = 0; h < f.positions.size(); ++h) {
+    const double d = (f.positions[h] - f.sample).norm();
+    if (!(d <= limit)) {
+      return "forecast point " + std::to_string(h + 1) + " is " + std::to_string(d) +
+             " m from the newest sample (at most " + std::to_string(limit) + " m)";
+    }
+  }
+  return "";
+}
+
+Forecast TrajectoryPredictor::recover(int64_t grid_utime, int64_t source, std::string why) {
+  Forecast lost;
+  lost.utime = grid_utime;
+  lost.source_utime = source;
+  lost.period_us = params_.period_us;
+  lost.status = status_ = TrackStatus::kLost;
+  reset();
+  ++resets_;
+  last_reset_ = std::move(why);
+  return lost;
+}
+
 std::vector<Forecast> TrajectoryPredictor::add(const Measurement& in) {
   std::vector<Forecast> out;
-  if ((in.visible && !in.position.allFinite()) || (started_ && in.utime <= last_utime_)) {
+  if (in.visible && !in.position.allFinite()) {
     ++rejected_;
     return out;
   }
+  if (started_ && in.utime <= last_utime_) {
+    if (++backward_run_ < kMaxBackwardRun) {
+      ++rejected_;
+      return out;
+    }
+    out.push_back(recover(in.utime, in.utime,
+                          std::to_string(kMaxBackwardRun) +
+                              " measurements in a row not after the last (the clock went back)"));
+  }
+  backward_run_ = 0;
   Measurement m = in;
   if (outside_gate(m)) m.visible = false;
   last_utime_ = m.utime;
@@ -130,14 +169,16 @@ std::vector<Forecast> TrajectoryPredictor::add(const Measurement& in) {
   while (next_grid_ <= m.utime) {
     const bool interpolate =
         m.visible && have_seen_ && m.utime - seen_utime_ <= 2 * params_.period_us;
+    std::optional<Forecast> f;
     if (next_grid_ == m.utime && m.visible) {
-      out.push_back(emit_sample(next_grid_, m.position, true, m.utime));
+      f = emit_sample(next_grid_, m.position, true, m.utime);
     } else if (interpolate && next_grid_ >= seen_utime_) {
       const double s = static_cast<double>(next_grid_ - seen_utime_) /
                        static_cast<double>(m.utime - seen_utime_);
-      out.push_back(emit_sample(next_grid_, seen_position_ + s * (m.position - seen_position_),
-                                true, m.utime));
-    } else {
+      f = emit_sample(next_grid_, seen_position_ + s * (m.position - seen_position_), true,
+                      m.utime);
+    }
+    if (!f) {
       if (occluded_ >= params_.max_gap) {  // lost: start again from the next sighting
         Forecast lost;
         lost.utime = next_grid_;
@@ -154,8 +195,13 @@ std::vector<Forecast> TrajectoryPredictor::add(const Measurement& in) {
         }
         return out;
       }
-      out.push_back(emit_sample(next_grid_, one_step(), false, m.utime));
+      f = emit_sample(next_grid_, one_step(), false, m.utime);
     }
+    if (std::string why = insane(*f); !why.empty()) {  // start again from the next sighting
+      out.push_back(recover(f->utime, m.utime, std::move(why)));
+      return out;
+    }
+    out.push_back(std::move(*f));
     next_grid_ += params_.period_us;
   }
   if (m.visible) {

@@ -12,6 +12,9 @@
 
 namespace sg::predictor {
 
+/// The longest horizon H a predictor makes (and sg-grasp accepts in an OBJECT_TRAJECTORY).
+constexpr int kMaxHorizon = 1000;
+
 /// Which model predicts: the paper's Burg predictors, or a baseline behind the same interface.
 enum class Model { kBurg, kKalman, kHold };
 Model model_from_name(const std::string& name);  ///< "burg", "kalman", "hold"; throws otherwise
@@ -31,6 +34,11 @@ struct PredictorParams {
   double gate = 0.010;
   /// ... unless measurements have disagreed for longer than this: then the ball is where they say.
   int64_t gate_patience_us = 500'000;
+  /// The predictor's own sanity check, independent of any gate in front of it: a grid sample
+  /// farther than this from the robot's base, or a forecast point that is not finite or farther
+  /// than this from the newest sample, resets the predictor (m; the track is reported lost and
+  /// starts again at the next sighting), so no input can leave it poisoned.
+  double reset_distance = 10.0;
 };
 
 /// One measurement of the ball (OBJECT_POSITION).
@@ -71,10 +79,20 @@ class TrajectoryPredictor {
 
   /// Adds a measurement; returns a forecast for each grid sample it completes (often none or one).
   /// A NaN or infinite visible position, a utime before the last one, or a repeated utime is
-  /// rejected (counted, nothing changes) and returns nothing.
+  /// rejected (counted, nothing changes) and returns nothing; after kMaxBackwardRun such times in
+  /// a row (a clock stepped back, a log replayed again) the predictor resets and takes it. A
+  /// forecast that fails the sanity check (reset_distance) resets the predictor: it is replaced
+  /// by a kLost forecast and counted in resets().
   std::vector<Forecast> add(const Measurement& m);
 
+  /// Measurements in a row whose time is not after the last before the predictor starts again.
+  static constexpr int kMaxBackwardRun = 100;
+
   uint64_t rejected() const { return rejected_; }
+  /// Times the predictor reset itself (a failed sanity check, a clock stepped back).
+  uint64_t resets() const { return resets_; }
+  /// Why it last reset ("" before any): "forecast (1e+298, 0, 0) m is 1e+298 m from ...".
+  const std::string& last_reset() const { return last_reset_; }
   /// Visible measurements the gate took as not seen.
   uint64_t gated() const { return gated_; }
   TrackStatus status() const { return status_; }
@@ -82,6 +100,10 @@ class TrajectoryPredictor {
 
  private:
   void reset();
+  /// reset(), counted, with the reason; returns the kLost forecast that replaces the bad one.
+  Forecast recover(int64_t grid_utime, int64_t source, std::string why);
+  /// "" when the forecast and its sample are sane (see reset_distance), else why not.
+  std::string insane(const Forecast& f) const;
   Forecast emit_sample(int64_t grid_utime, const Eigen::Vector3d& value, bool measured,
                        int64_t source);
   Eigen::Vector3d one_step() const;
@@ -103,6 +125,9 @@ class TrajectoryPredictor {
   int occluded_ = 0;                                       // consecutive fed-back samples
   Eigen::Vector3d last_sample_ = Eigen::Vector3d::Zero();  // the newest grid sample
   uint64_t gated_ = 0;
+  uint64_t resets_ = 0;
+  std::string last_reset_;
+  int backward_run_ = 0;  // measurements in a row refused as not after the last
   std::optional<int64_t> gating_since_;  // first of the current run of gated measurements
 };
 

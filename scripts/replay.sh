@@ -95,7 +95,9 @@ fi
 if [ "$from" = vision ] || [ "$from" = predictor ]; then
   coefficients=()  # the demo's offline-trained starting coefficients, when they are beside the log
   [ -r "$session.coefficients.yaml" ] && coefficients=(--coefficients "$session.coefficients.yaml")
-  "$bin/sg-predictor" --lcm-url "$url" --log-level warn "${coefficients[@]}" "${first[@]}" &
+  # --max-time-offset 0: the log's capture times are old, the plausibility gate must not refuse them
+  "$bin/sg-predictor" --lcm-url "$url" --log-level warn --max-time-offset 0 "${coefficients[@]}" \
+    "${first[@]}" &
   pids+=($!)
   first=()
 fi

@@ -90,23 +90,23 @@ void degrees(Section& section, const std::string& key, double& radians, const Ra
 
 void read_rig(const Config& config, RigParams& r) {
   Section c(config, "rig");
-  vector3(c, "target", r.target, Range::finite(), "where the optical axes meet, robot frame (m)");
-  c.number("baseline", r.baseline, Range::above(0), "m between the camera centres");
+  vector3(c, "target", r.target, Range::closed(-10, 10), "where the optical axes meet, robot frame (m)");
+  c.number("baseline", r.baseline, Range::above_to(0, 10), "m between the camera centres");
   degrees(c, "toe_in_deg", r.toe_in, Range::above_to(0, 89.9), "each camera turned inward");
   degrees(c, "pitch_deg", r.pitch, Range::closed(-90, 90), "the rig's elevation over the target");
   degrees(c, "azimuth_deg", r.azimuth, Range::closed(-360, 360),
           "direction from the target to the rig (0: from +X)");
   c.number("width", r.width, Range::closed(16, 16384), "image width (px)");
   c.number("height", r.height, Range::closed(16, 16384), "image height (px)");
-  c.number("fx", r.intrinsics.fx, Range::above(0), "focal length (px)");
-  c.number("fy", r.intrinsics.fy, Range::above(0), "focal length (px)");
+  c.number("fx", r.intrinsics.fx, Range::above_to(0, 1e5), "focal length (px)");
+  c.number("fy", r.intrinsics.fy, Range::above_to(0, 1e5), "focal length (px)");
   r.intrinsics.cx = (r.width - 1) / 2.0;  // the image centre unless given
   r.intrinsics.cy = (r.height - 1) / 2.0;
-  c.number("cx", r.intrinsics.cx, Range::finite(), "principal point (px)");
-  c.number("cy", r.intrinsics.cy, Range::finite(), "principal point (px)");
+  c.number("cx", r.intrinsics.cx, Range::closed(-1e5, 1e5), "principal point (px)");
+  c.number("cy", r.intrinsics.cy, Range::closed(-1e5, 1e5), "principal point (px)");
   double d[5] = {r.distortion.k1, r.distortion.k2, r.distortion.p1, r.distortion.p2,
                  r.distortion.k3};
-  c.numbers("distortion", d, 5, Range::finite(), "k1 k2 p1 p2 k3 (OpenCV's model)");
+  c.numbers("distortion", d, 5, Range::closed(-100, 100), "k1 k2 p1 p2 k3 (OpenCV's model)");
   r.distortion = {d[0], d[1], d[2], d[3], d[4]};
   c.done();
 }
@@ -114,20 +114,20 @@ void read_rig(const Config& config, RigParams& r) {
 void read_scenario(const Config& config, ScenarioParams& s) {
   Section c(config, "scenario");
   c.choice("kind", s.kind, scenario_kinds(), "how the ball moves");
-  vector3(c, "centre", s.centre, Range::finite(), "m, robot frame");
-  c.number("radius", s.radius, Range::at_least(0), "m (paper, circle, figure8)");
-  c.number("rpm", s.rpm, Range::finite(), "revolutions per minute");
-  degrees(c, "phase_deg", s.phase, Range::finite(), "the starting phase (default: from the seed)");
-  c.number("drift_speed", s.drift_speed, Range::at_least(0), "paper: back-and-forth along Y (m/s)");
-  c.number("drift_half_period", s.drift_half_period, Range::above(0),
+  vector3(c, "centre", s.centre, Range::closed(-10, 10), "m, robot frame");
+  c.number("radius", s.radius, Range::closed(0, 10), "m (paper, circle, figure8)");
+  c.number("rpm", s.rpm, Range::closed(-600, 600), "revolutions per minute");
+  degrees(c, "phase_deg", s.phase, Range::closed(-360, 360), "the starting phase (default: from the seed)");
+  c.number("drift_speed", s.drift_speed, Range::closed(0, 10), "paper: back-and-forth along Y (m/s)");
+  c.number("drift_half_period", s.drift_half_period, Range::above_to(0, 86400),
            "s between the drift's reversals");
-  vector3(c, "line_direction", s.line_direction, Range::finite(), "line: its direction");
-  c.number("line_half_length", s.line_half_length, Range::above(0), "line: m each way");
-  c.number("line_speed", s.line_speed, Range::above(0), "line: m/s");
-  c.number("random_extent", s.random_extent, Range::above(0), "random: m from the centre");
-  c.number("random_speed", s.random_speed, Range::above(0), "random: m/s");
+  vector3(c, "line_direction", s.line_direction, Range::closed(-1e3, 1e3), "line: its direction");
+  c.number("line_half_length", s.line_half_length, Range::above_to(0, 10), "line: m each way");
+  c.number("line_speed", s.line_speed, Range::above_to(0, 10), "line: m/s");
+  c.number("random_extent", s.random_extent, Range::above_to(0, 10), "random: m from the centre");
+  c.number("random_speed", s.random_speed, Range::above_to(0, 10), "random: m/s");
   int64_t seed = static_cast<int64_t>(s.seed);
-  c.number("seed", seed, Range::at_least(0), "the starting phase, noise, distractors");
+  c.number("seed", seed, Range::closed(0, 4294967295.0), "the starting phase, noise, distractors");
   s.seed = static_cast<uint64_t>(seed);
   c.done();
   try {
@@ -142,25 +142,28 @@ void read_occlusion(const Config& config, OcclusionParams& o) {
   std::vector<std::vector<double>> episodes;
   if (c.read("episodes", episodes, "[]", "[start_s, duration_s] pairs", 0)) {
     for (const auto& e : episodes) {
-      if (e.size() != 2 || !std::isfinite(e[0]) || !(e[1] >= 0 && std::isfinite(e[1])))
-        throw c.error("episodes", "must be a list of [start_s, duration_s] pairs");
+      if (e.size() != 2 || !Range::closed(0, 86400).contains(e[0]) ||
+          !Range::closed(0, 3600).contains(e[1]))
+        throw c.error("episodes",
+                      "must be a list of [start_s, duration_s] pairs, start_s in [0, 86400], "
+                      "duration_s in [0, 3600]");
       o.episodes.push_back({e[0], e[1]});
     }
   }
-  c.number("transition", o.transition, Range::at_least(0), "s to slide in and out");
-  c.number("standoff", o.standoff, Range::above(0), "panel distance from the ball (m)");
-  c.number("width", o.width, Range::above(0), "panel width (m)");
-  c.number("height", o.height, Range::above(0), "panel height (m)");
+  c.number("transition", o.transition, Range::closed(0, 60), "s to slide in and out");
+  c.number("standoff", o.standoff, Range::above_to(0, 10), "panel distance from the ball (m)");
+  c.number("width", o.width, Range::above_to(0, 10), "panel width (m)");
+  c.number("height", o.height, Range::above_to(0, 10), "panel height (m)");
   c.done();
 }
 
 void read_lighting(const Config& config, LightingParams& l) {
   Section c(config, "lighting");
-  c.number("gain_amplitude", l.gain_amplitude, Range::at_least(0), "exposure gain 1 +- this");
-  c.number("gain_period", l.gain_period, Range::above(0), "s");
-  c.number("colour_amplitude", l.colour_amplitude, Range::at_least(0),
+  c.number("gain_amplitude", l.gain_amplitude, Range::closed(0, 1), "exposure gain 1 +- this");
+  c.number("gain_period", l.gain_period, Range::above_to(0, 86400), "s");
+  c.number("colour_amplitude", l.colour_amplitude, Range::closed(0, 1),
            "colour balance drift per channel");
-  c.number("colour_period", l.colour_period, Range::above(0), "s");
+  c.number("colour_period", l.colour_period, Range::above_to(0, 86400), "s");
   c.done();
 }
 
@@ -168,14 +171,14 @@ void read_camera_sim(const Config& config, SimParams& p) {
   Section c(config, "camera_sim");
   c.number("rate_hz", p.frame_rate, Range::above_to(0, 1000), "frames per second");
   c.choice("encoding", p.encoding, {"jpeg", "raw"}, "image_t encoding on the bus");
-  c.number("ball_radius", p.ball_radius, Range::above(0), "m");
-  c.number("noise_sigma", p.noise_sigma, Range::at_least(0), "sensor noise, grey levels");
+  c.number("ball_radius", p.ball_radius, Range::above_to(0, 1), "m");
+  c.number("noise_sigma", p.noise_sigma, Range::closed(0, 255), "sensor noise, grey levels");
   c.number("distractors", p.scene.distractors, Range::closed(0, 1000),
            "small red stickers of the ball's hue");
-  c.number("exposure", p.exposure, Range::at_least(0), "s; blurs the moving ball");
+  c.number("exposure", p.exposure, Range::closed(0, 1), "s; blurs the moving ball");
   c.number("motion_blur_samples", p.motion_blur_samples, Range::closed(1, 64),
            "renders averaged over the exposure");
-  c.number("min_visible_px", p.min_visible_px, Range::at_least(0),
+  c.number("min_visible_px", p.min_visible_px, Range::closed(0, 1e8),
            "a camera sees the ball above this area (px)");
   c.done();
 }

@@ -26,32 +26,33 @@ Eigen::Vector3d tool_down_rpy(const Eigen::Vector3d& position) {
 RobotCalibrationParams load_robot_calibration_params(const Config& config) {
   RobotCalibrationParams p;
   Section c(config, "calibrate_robot");
-  c.numbers("box_min", p.box_min.data(), 3, Range::finite(),
+  c.numbers("box_min", p.box_min.data(), 3, Range::closed(-10, 10),
             "a corner of the grid of the tool centre point, robot frame (m)");
-  c.numbers("box_max", p.box_max.data(), 3, Range::finite(), "the opposite corner (m)");
+  c.numbers("box_max", p.box_max.data(), 3, Range::closed(-10, 10), "the opposite corner (m)");
   if (!(p.box_min.array() <= p.box_max.array()).all())
     throw c.error("box_max", "must be at least box_min on every axis");
   std::vector<int> g = {p.nx, p.ny, p.nz};
   const std::string grid_default = show({1.0 * p.nx, 1.0 * p.ny, 1.0 * p.nz});
   if (c.read("grid", g, grid_default, "points per axis nx ny nz (nz >= 2, 12 in all)", 3)) {
-    if (g.size() != 3 || g[0] < 1 || g[1] < 1 || g[2] < 2 || g[0] * g[1] * g[2] < 12)
-      throw c.error("grid", "must be [nx, ny, nz], nz >= 2, at least 12 points");
+    if (g.size() != 3 || g[0] < 1 || g[1] < 1 || g[2] < 2 || g[0] > 100 || g[1] > 100 ||
+        g[2] > 100 || g[0] * g[1] * g[2] < 12)
+      throw c.error("grid", "must be [nx, ny, nz], each at most 100, nz >= 2, at least 12 points");
     p.nx = g[0], p.ny = g[1], p.nz = g[2];
   }
   Eigen::Vector3d rpy(M_PI, 0, 0);
   const bool rpy_given =
       c.known("tool_rpy", "pi 0 atan2(y,x)+pi", "tool roll pitch yaw at every stop (rad)", 3);
-  c.numbers("tool_rpy", rpy.data(), 3, Range::finite(), "tool roll pitch yaw at every stop (rad)");
+  c.numbers("tool_rpy", rpy.data(), 3, Range::closed(-7, 7), "tool roll pitch yaw at every stop (rad)");
   if (rpy_given) p.tool_rpy = rpy;
-  c.numbers("ball_offset", p.ball_offset.data(), 3, Range::finite(),
+  c.numbers("ball_offset", p.ball_offset.data(), 3, Range::closed(-1, 1),
             "the ball's centre from the tool centre point, tool frame (m)");
   c.number("speed", p.speed, Range::above_to(0, 1), "arm speed, fraction of the joint limits");
-  c.number("frames_per_stop", p.frames_per_stop, Range::at_least(1),
+  c.number("frames_per_stop", p.frames_per_stop, Range::closed(1, 10000),
            "blobs averaged per camera at each stop");
-  c.number("settle", p.settle, Range::at_least(0), "s after arrival before blobs count");
-  c.number("max_misses_per_stop", p.max_misses_per_stop, Range::at_least(1),
+  c.number("settle", p.settle, Range::closed(0, 600), "s after arrival before blobs count");
+  c.number("max_misses_per_stop", p.max_misses_per_stop, Range::closed(1, 1e6),
            "frames without the ball before a stop is skipped");
-  c.number("timeout", p.timeout, Range::above(0), "s without progress before giving up");
+  c.number("timeout", p.timeout, Range::above_to(0, 86400), "s without progress before giving up");
   c.done();
   return p;
 }

@@ -25,19 +25,19 @@ VisionSettings read_vision_settings(const Config& config) {
   band(c, "b_range", k.b_min, k.b_max, "normalized b of the ball");
   c.number("min_intensity", k.min_intensity, Range::closed(0, 765),
            "R+G+B below this is too dark to have a colour");
-  c.number("min_area", p.min_area, Range::at_least(1), "px: smaller regions are ignored");
+  c.number("min_area", p.min_area, Range::closed(1, 1e8), "px: smaller regions are ignored");
   c.number("min_area_fraction_of_last", p.min_area_fraction_of_last, Range::closed(0, 1),
            "while tracking, a region must be this much of the ball's last area");
-  c.number("forget_size_after_misses", p.forget_size_after_misses, Range::at_least(0),
+  c.number("forget_size_after_misses", p.forget_size_after_misses, Range::closed(0, 1e6),
            "... until the ball has been missing this many frames");
-  c.number("window_diameter_factor", w.diameter_factor, Range::above(0),
+  c.number("window_diameter_factor", w.diameter_factor, Range::above_to(0, 100),
            "search window side = this x the apparent diameter");
   c.number("window_max_width", w.max_width_fraction, Range::above_to(0, 1),
            "at most this fraction of the image width ...");
   c.number("window_max_height", w.max_height_fraction, Range::above_to(0, 1),
            "... and of its height");
-  c.number("window_growth", w.growth, Range::at_least(1), "the window grows by this per miss");
-  c.number("misses_before_full_frame", w.misses_before_full_frame, Range::at_least(0),
+  c.number("window_growth", w.growth, Range::closed(1, 100), "the window grows by this per miss");
+  c.number("misses_before_full_frame", w.misses_before_full_frame, Range::closed(0, 1e6),
            "misses before the whole image is searched");
   c.done();
   return s;

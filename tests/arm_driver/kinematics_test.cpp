@@ -384,7 +384,8 @@ TEST(LoadArmGeometry, ReadsValuesInDegreesAndMetres) {
 // errors naming the key.
 TEST(LoadArmGeometry, BadValuesNameTheKey) {
   const std::string length = load_error("arm:\n  max_speed_deg_s: [180, 180, 180, 171, 173]\n");
-  EXPECT_NE(length.find("key 'arm.max_speed_deg_s': expected 6 numbers, got 5"), std::string::npos)
+  EXPECT_NE(length.find("key 'arm.max_speed_deg_s': must be a list of 6 numbers, got 5"),
+            std::string::npos)
       << length;
   const std::string limits = load_error(
       "arm:\n  limits_deg: [[-175, 175], [90, -90], [-110, 110], [-180, 180], [-105, 105], "

@@ -242,16 +242,18 @@ TEST(GraspNodeTest, StatusOnChangeAndOnPeriod) {
   EXPECT_TRUE(rig.poll().status.has_value());
 }
 
-// A malformed trajectory is ignored with the reason; its utime still dates the next command.
+// A malformed trajectory is ignored with the reason, and its utime does not date the next
+// command (a refused message leaves nothing behind).
 TEST(GraspNodeTest, MalformedTrajectoryIsIgnored) {
   Rig rig;
   trajectory_t m = rig.trajectory();
   m.period_us = 0;
-  EXPECT_EQ(rig.node.on_trajectory(m, rig.now), "period 0 us");
+  m.utime -= kSecond;
+  EXPECT_EQ(rig.node.on_trajectory(m, rig.now), "period 0 us (1 ms to 60 s)");
   rig.connect();
   const GraspNode::Output open = rig.poll();
   ASSERT_TRUE(open.arm_command.has_value());
-  EXPECT_EQ(open.arm_command->utime, m.utime);
+  EXPECT_EQ(open.arm_command->utime, rig.now);  // no trajectory yet: the node's time
 }
 
 }  // namespace
