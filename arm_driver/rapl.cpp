@@ -126,7 +126,7 @@ Location parse_location(const Reply& reply) {
     Location location;
     // The name as sent (split.verb is upper-cased), after the separators split_command skips.
     const std::string_view named = std::string_view(line).substr(line.find_first_not_of(", \t"));
-    location.name = std::string(named.substr(0, named.find(' ')));
+    location.name = std::string(named.substr(0, named.find_first_of(" \t")));  // as the verb ends
     for (int i = 0; i < 3; ++i) location.xyz[i] = from_inches(values[i]);
     for (int i = 0; i < 3; ++i) location.rpy[i] = from_degrees(values[3 + i]);
     return location;

@@ -42,6 +42,14 @@ void write_camera(cv::FileStorage& fs, const std::string& name, const CameraMode
 cv::Mat read_matrix(const cv::FileNode& node, const std::string& path, const std::string& key,
                     int rows, int cols) {
   if (node.empty()) throw CalibrationError(path + ": key '" + key + "' is missing");
+  const std::string shape = "must be a " + std::to_string(rows) + "x" + std::to_string(cols) +
+                            " matrix";
+  // The size it claims first: OpenCV allocates rows x cols before reading the data (a 40-byte
+  // claim of 10^5 x 10^5 asked for 48 GB in fuzz/calibration_fuzz).
+  if (!node["rows"].isInt() || !node["cols"].isInt() || static_cast<int>(node["rows"]) != rows ||
+      static_cast<int>(node["cols"]) != cols) {
+    throw CalibrationError(path + ": key '" + key + "' " + shape);
+  }
   cv::Mat m;
   try {
     node >> m;
@@ -49,8 +57,7 @@ cv::Mat read_matrix(const cv::FileNode& node, const std::string& path, const std
     m.release();
   }
   if (m.empty() || m.rows != rows || m.cols != cols) {
-    throw CalibrationError(path + ": key '" + key + "' must be a " + std::to_string(rows) + "x" +
-                           std::to_string(cols) + " matrix");
+    throw CalibrationError(path + ": key '" + key + "' " + shape);
   }
   m.convertTo(m, CV_64F);
   if (!cv::checkRange(m)) throw CalibrationError(path + ": key '" + key + "' is not finite");

@@ -280,6 +280,14 @@ TEST(RaplParseLocation, LeadingBlanks) {
   EXPECT_DOUBLE_EQ(location.xyz.x(), 0.0254);
 }
 
+// A tab after the name ends it, as it ends the verb (fuzz/rapl_fuzz: the name took the first
+// number, and the location printed again no longer parsed).
+TEST(RaplParseLocation, TabAfterTheName) {
+  const Location location = parse_location(reply_of({"P1\t1 10 -0.5 180 0 -90"}));
+  EXPECT_EQ(location.name, "P1");
+  EXPECT_EQ(parse_location(reply_of({format_location_reply(location)})).name, "P1");
+}
+
 // Too few numbers, NaN, a non-number, an error only or nothing are errors.
 TEST(RaplParseLocation, Malformed) {
   EXPECT_THROW(parse_location(reply_of({"P1 1 2 3 4 5"})), RaplError);

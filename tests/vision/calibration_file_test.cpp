@@ -76,6 +76,19 @@ TEST(CalibrationFile, BadKeysAreNamed) {
   std::ofstream(dir + "/crash.xml", std::ios::binary)
       << std::string("<?xmlSSfffffzfffff\nfffffffff=\0\0\0\0\0\0\0fxmlSSS", 43);
   EXPECT_THROW(read_calibration(dir + "/crash.xml"), CalibrationError);
+  // A matrix claiming 10^5 x 10^5 is refused before OpenCV allocates it (fuzz/calibration_fuzz).
+  std::string huge = good;
+  huge.replace(huge.find("cols: 3", huge.find("camera_right")), 7, "cols: 100000");
+  huge.replace(huge.rfind("rows: 3", huge.find("cols: 100000")), 7, "rows: 100000");
+  std::ofstream(dir + "/huge.yaml") << huge;
+  try {
+    read_calibration(dir + "/huge.yaml");
+    FAIL() << "accepted";
+  } catch (const CalibrationError& e) {
+    EXPECT_NE(std::string(e.what()).find("'camera_right.K' must be a 3x3 matrix"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 // A failed write leaves the good file that was there.
