@@ -98,6 +98,14 @@ void ArmDriver::submit(const Cmd& command) {
   clock_.notify();
 }
 
+void ArmDriver::refuse(const Cmd& command, const std::string& why) {
+  std::lock_guard lock(mutex_);
+  status_.last_rejected_sequence = command.sequence;
+  status_.rejection_reason = why;
+  spdlog::warn("refused command {} from '{}': {}", command.sequence, command.sender, why);
+  ++version_;
+}
+
 std::pair<Status, uint64_t> ArmDriver::status() const {
   std::lock_guard lock(mutex_);
   return {status_, version_};

@@ -51,6 +51,11 @@ class ArmDriver {
   /// Validates a command (bus thread) and puts it in the slot, or records its rejection.
   void submit(const stereograsp::arm_cmd_t& command);
 
+  /// Records a command refused before validation (e.g. unauthenticated: `why`) as rejected in
+  /// the status, leaving what judges later commands untouched: last_received_sequence, the
+  /// validator's per-sender sequence and the pending command.
+  void refuse(const stereograsp::arm_cmd_t& command, const std::string& why);
+
   /// The status with utime unset, and a version that changes with every change.
   std::pair<stereograsp::arm_status_t, uint64_t> status() const;
 

@@ -1,5 +1,6 @@
 // sg-arm-ctl: the arm from the lab bench. Sends one ARM_COMMAND and waits until sg-arm-driver
-// reports it executed (or rejected, with the reason), or prints ARM_STATUS.
+// reports it executed (or rejected, with the reason), or prints ARM_STATUS. Commands are signed
+// with the lab key (--key, default $SG_LAB_KEY or ~/.config/stereograsp/lab.key; docs/security.md).
 //
 //   sg-arm-ctl move 0.45 0.0 0.25                   # tool centre point (m), tool pointing down
 //   sg-arm-ctl move 0.45 0.0 0.25 --rpy 3.1416 0 0 --speed 0.2 --wait
@@ -11,6 +12,7 @@
 #include <cstdio>
 #include <numbers>
 
+#include "auth/lab_access.hpp"
 #include "common/bus.hpp"
 #include "common/clock.hpp"
 #include "common/program.hpp"
@@ -132,6 +134,8 @@ int main(int argc, char** argv) {
                "sg-arm-ctl"};
   sg::CommonOptions common;
   sg::add_common_options(app, common);
+  sg::auth::KeyOptions key_options;
+  sg::auth::add_key_options(app, key_options);
   double speed = 0.5, timeout = 10;
   bool wait_idle = false, degrees = false, follow = false;
   std::vector<double> xyz, rpy, joints;
@@ -179,6 +183,9 @@ int main(int argc, char** argv) {
     } else if (!*stop) {
       throw std::runtime_error("no command");
     }
-    return send(bus, c, wait_idle, timeout);
+    return sg::auth::with_lab_access(app.get_name(), key_options, [&](sg::auth::LabAccess& lab) {
+      lab.sign("ARM_COMMAND", c);
+      return send(bus, c, wait_idle, timeout);
+    });
   });
 }

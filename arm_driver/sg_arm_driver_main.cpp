@@ -3,9 +3,13 @@
 // the workspace), keeps one controller interaction in flight with the newest command waiting
 // (latest wins), and publishes ARM_STATUS at --status-rate and on every change. Reconnects with
 // back-off when the device vanishes. The same binary drives a real C550 or sg-c550-sim.
+// Every ARM_COMMAND must be signed with the lab key (docs/security.md): an unsigned, forged,
+// replayed or stale one is refused (ARM_STATUS: last_rejected_sequence, "unauthenticated: ...")
+// before it reaches the validator, so it cannot move the arm or lock its sender out.
 //
 //   sg-arm-driver --device /dev/ttyUSB0              # a real C550 at 38,400 8N1
 //   sg-arm-driver --device /tmp/c550                  # sg-c550-sim --link /tmp/c550
+//   sg-arm-driver --device /tmp/c550 --key lab.key    # a key other than $SG_LAB_KEY's
 
 #include <spdlog/spdlog.h>
 
@@ -13,6 +17,7 @@
 #include <thread>
 
 #include "arm_driver/arm_driver.hpp"
+#include "auth/lab_access.hpp"
 #include "arm_driver/driver_settings_io.hpp"
 #include "arm_driver/serial_port.hpp"
 #include "common/bus.hpp"
@@ -24,7 +29,7 @@
 namespace {
 
 int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
-        const sg::arm::ArmDriverSettings& s) {
+        const sg::arm::ArmDriverSettings& s, sg::auth::LabAccess& lab) {
   sg::install_shutdown_handlers();
   sg::Bus bus(url);
   sg::arm::SerialPort::open(s.device, s.serial).reset();  // fail now, clearly, on a bad path
@@ -33,7 +38,14 @@ int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
   });
   bus.subscribe<stereograsp::arm_cmd_t>(
       "ARM_COMMAND",
-      [&](const stereograsp::arm_cmd_t& command, const sg::ReceiveInfo&) { driver.submit(command); });
+      [&](const stereograsp::arm_cmd_t& command, const sg::ReceiveInfo& info) {
+        const std::string why = lab.refusal(info.channel, command, sg::now_utime());
+        if (why.empty()) {
+          driver.submit(command);
+        } else {
+          driver.refuse(command, why);
+        }
+      });
   spdlog::info("driving the C550 on {} at {}", s.device, sg::arm::describe(s.serial));
   std::jthread worker([&](std::stop_token stop) { driver.run(stop); });
   sg::ChangeOrPeriod rule(1.0 / s.status_rate_hz);
@@ -57,6 +69,8 @@ int main(int argc, char** argv) {
                "sg-arm-driver"};
   sg::CommonOptions common;
   sg::add_common_options(app, common);
+  sg::auth::KeyOptions key_options;
+  sg::auth::add_key_options(app, key_options);
   const auto keys = sg::declared_keys(sg::arm::read_arm_driver_settings);
   common.flags.add(app, "--device", "arm_driver.device", keys);
   common.flags.add(app, "--baud", "arm_driver.baud", keys);
@@ -68,6 +82,8 @@ int main(int argc, char** argv) {
     const sg::arm::ArmDriverSettings settings = sg::arm::read_arm_driver_settings(config);
     if (settings.device.empty())
       throw std::runtime_error("no serial device: give --device PATH (or arm_driver.device)");
-    return run(common.lcm_url, sg::arm::load_arm_geometry(config), settings);
+    return sg::auth::with_lab_access(app.get_name(), key_options, [&](sg::auth::LabAccess& lab) {
+      return run(common.lcm_url, sg::arm::load_arm_geometry(config), settings, lab);
+    });
   });
 }

@@ -33,15 +33,16 @@ inline const char* grasp_outcome_name(int outcome) {
   return outcome >= 0 && outcome <= 3 ? names[outcome] : "unknown";
 }
 
-/// RESULT_NONE .. RESULT_REFUSED_STATE: what became of the last GRASP_COMMAND.
+/// RESULT_NONE .. RESULT_REFUSED_UNAUTHENTICATED: what became of the last GRASP_COMMAND.
 inline const char* grasp_command_result_name(int result) {
   static const char* const names[] = {"none",
                                       "accepted",
                                       "refused: not newer",
                                       "refused: unknown command",
                                       "refused: bad argument",
-                                      "refused: state"};
-  return result >= 0 && result <= 5 ? names[result] : "unknown";
+                                      "refused: state",
+                                      "refused: unauthenticated"};
+  return result >= 0 && result <= 6 ? names[result] : "unknown";
 }
 
 }  // namespace sg

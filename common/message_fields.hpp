@@ -57,7 +57,7 @@ template <class M, class V>
 void visit_fields(M& m, V& v) {
   SG_FIELD(utime); SG_FIELD(source_utime); SG_FIELD(target_utime); SG_FIELD(sequence);
   SG_FIELD(mode); SG_FIELD(position); SG_FIELD(orientation); SG_FIELD(joints); SG_FIELD(gripper);
-  SG_FIELD(speed); SG_FIELD(sender);
+  SG_FIELD(speed); SG_FIELD(sender); SG_FIELD(auth_counter); SG_FIELD(auth_tag);
 }
 template <class M, class V>
   requires std::same_as<std::remove_const_t<M>, stereograsp::arm_status_t>
@@ -71,6 +71,7 @@ template <class M, class V>
   requires std::same_as<std::remove_const_t<M>, stereograsp::grasp_command_t>
 void visit_fields(M& m, V& v) {
   SG_FIELD(utime); SG_FIELD(sequence); SG_FIELD(command); SG_FIELD(standoff); SG_FIELD(sender);
+  SG_FIELD(auth_counter); SG_FIELD(auth_tag);
 }
 template <class M, class V>
   requires std::same_as<std::remove_const_t<M>, stereograsp::grasp_status_t>

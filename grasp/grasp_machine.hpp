@@ -169,10 +169,11 @@ enum class CommandResult : int8_t {
   kRefusedUnknownCommand = 3,  ///< not a COMMAND_* value
   kRefusedBadArgument = 4,     ///< e.g. a stand-off outside 0..0.5 m
   kRefusedState = 5,           ///< not in this state (a grasp without a fresh track, ...)
+  kRefusedUnauthenticated = 6,  ///< unsigned, a wrong tag, replayed or stale (docs/security.md)
 };
 
 /// "none", "accepted", "refused: not newer", "refused: unknown command", "refused: bad
-/// argument", "refused: state".
+/// argument", "refused: state", "refused: unauthenticated".
 const char* to_string(CommandResult result);
 
 /// The machine's answer to a command.

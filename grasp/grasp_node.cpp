@@ -62,7 +62,20 @@ void GraspNode::on_arm_status(const stereograsp::arm_status_t& status, int64_t n
   machine_.on_arm_status(arm_view_of(status), now);
 }
 
+void GraspNode::require_signed_commands(const auth::LabKey& key, std::string channel,
+                                        auth::VerifierSettings settings) {
+  verifier_.emplace(key, settings);
+  command_channel_ = std::move(channel);
+}
+
 const CommandRecord& GraspNode::on_command(const stereograsp::grasp_command_t& m, int64_t now) {
+  if (verifier_) {
+    const auth::Verification v = verifier_->verify(command_channel_, m, now);
+    if (!v.accepted()) {
+      return answer(m.sequence, CommandResult::kRefusedUnauthenticated,
+                    "unauthenticated: " + v.reason);
+    }
+  }
   std::string why;
   if (!newer(m, now, &why)) return answer(m.sequence, CommandResult::kRefusedNotNewer, why);
   if (m.command < stereograsp::grasp_command_t::COMMAND_TRACK ||

@@ -6,6 +6,10 @@
 /// the Unix epoch); the node never reads a clock, so an in-process trial on a simulated clock
 /// (system/grasp_trial.cpp) drives the same logic as sg-grasp.
 ///
+///   - GRASP_COMMAND, once require_signed_commands() was called (sg-grasp does, unless
+///     --insecure-no-key): first refused, RESULT_REFUSED_UNAUTHENTICATED, when unsigned, not
+///     signed with the lab key for this channel, replayed or stale (auth/command_auth.hpp);
+///     such a command changes nothing the later checks use, so a forged one locks no one out.
 ///   - GRASP_COMMAND: refused when its `sequence` is not newer than its sender's last (a replay),
 ///     when `command` is not a COMMAND_* value, or when `standoff` is not finite in 0..0.5 m;
 ///     otherwise the machine answers (accepted, or refused by its state). Every command's answer
@@ -24,6 +28,7 @@
 ///     in time, so a clock step cannot silence it).
 ///
 ///     GraspNode node(geometry, settings, /*first_sequence=*/now, /*status_period=*/0.25);
+///     node.require_signed_commands(key);                // the lab key (auth/lab_key.hpp)
 ///     node.on_command(command, now);                    // from each subscription
 ///     GraspNode::Output out = node.poll(now);           // from the loop, every 10 ms
 ///     if (out.arm_command) bus.publish("ARM_COMMAND", *out.arm_command);
@@ -35,6 +40,7 @@
 #include <optional>
 #include <string>
 
+#include "auth/command_auth.hpp"
 #include "common/change_or_period.hpp"
 #include "grasp/grasp_machine.hpp"
 #include "grasp/grasp_messages.hpp"
@@ -86,7 +92,17 @@ class GraspNode {
   /// An ARM_STATUS received at `now`.
   void on_arm_status(const stereograsp::arm_status_t& status, int64_t now);
 
-  /// A GRASP_COMMAND received at `now`: the sequence and range checks, then the machine.
+  /// From now on, GRASP_COMMAND must be signed with `key` for `channel` (the channel the
+  /// commands arrive on); `settings`: the verifier's maximum age and sender table.
+  void require_signed_commands(const auth::LabKey& key, std::string channel = "GRASP_COMMAND",
+                               auth::VerifierSettings settings = {});
+  /// The verifier of require_signed_commands() (its counts), nullptr before.
+  const auth::CommandVerifier* command_verifier() const {
+    return verifier_ ? &*verifier_ : nullptr;
+  }
+
+  /// A GRASP_COMMAND received at `now`: the signature (when required), the sequence and range
+  /// checks, then the machine.
   /// Returns the answer that the next GRASP_STATUS carries.
   const CommandRecord& on_command(const stereograsp::grasp_command_t& command, int64_t now);
 
@@ -119,6 +135,8 @@ class GraspNode {
   uint64_t status_version_ = 0;  ///< counts the changes of the summary and the command answer
   int64_t trajectory_utime_ = 0;  ///< the newest OBJECT_TRAJECTORY's utime (0: none yet)
   std::map<std::string, Sender> senders_;
+  std::optional<auth::CommandVerifier> verifier_;  ///< set by require_signed_commands()
+  std::string command_channel_;
   CommandRecord command_;
   bool command_changed_ = false;
   std::string last_summary_;

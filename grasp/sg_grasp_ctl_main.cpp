@@ -1,7 +1,9 @@
 // sg-grasp-ctl: the operator's side of sg-grasp. Sends one GRASP_COMMAND and waits for the
 // GRASP_STATUS that answers it (command_sequence = its sequence; command_result accepted or
 // refused), or, with --wait, until the grasp (or release, or homing) is over; `status` prints the
-// machine's state. Exit status: 0 done, 3 the grasp failed (--wait), 4 refused, 1 other errors.
+// machine's state. Exit status: 0 done, 3 the grasp failed (--wait), 4 refused (also when not
+// signed with sg-grasp's lab key), 2 no lab key (--key, default $SG_LAB_KEY or
+// ~/.config/stereograsp/lab.key; docs/security.md), 1 other errors.
 //
 //   sg-grasp-ctl track [--standoff 0.10]      # follow the ball, the gripper above it
 //   sg-grasp-ctl grasp --wait                 # q1 approach, q2 grasp, q3 closed, q4 lifted
@@ -13,6 +15,7 @@
 #include <functional>
 #include <optional>
 
+#include "auth/lab_access.hpp"
 #include "common/bus.hpp"
 #include "common/clock.hpp"
 #include "common/grasp_names.hpp"
@@ -62,13 +65,15 @@ std::optional<Status> watch(sg::Bus& bus, double timeout, bool follow,
 /// Exit code of a command that sg-grasp refused (command_result not RESULT_ACCEPTED).
 constexpr int kRefused = 4;
 
-int send(sg::Bus& bus, int8_t command, double standoff, bool wait, double timeout) {
+int send(sg::Bus& bus, sg::auth::LabAccess& lab, int8_t command, double standoff, bool wait,
+         double timeout) {
   Cmd c{};
   c.utime = sg::now_utime();
   c.sequence = c.utime;
   c.command = command;
   c.standoff = standoff;
   c.sender = "sg-grasp-ctl";
+  lab.sign("GRASP_COMMAND", c);
   bus.publish("GRASP_COMMAND", c);
   // The answer is the first status whose command_sequence is ours; then, for --wait, the
   // command has run its course: tracking, the grasp judged, or idle.
@@ -106,6 +111,8 @@ int main(int argc, char** argv) {
   CLI::App app{"Commands sg-grasp (GRASP_COMMAND) and prints GRASP_STATUS.", "sg-grasp-ctl"};
   sg::CommonOptions common;
   sg::add_common_options(app, common);
+  sg::auth::KeyOptions key_options;
+  sg::auth::add_key_options(app, key_options);
   double standoff = 0, timeout = 10;
   bool wait = false, follow = false;
   app.add_option("--timeout", timeout, "seconds to wait for sg-grasp (default 10; 60 with --wait)");
@@ -114,7 +121,7 @@ int main(int argc, char** argv) {
                "success, 3 on failure)");
   app.footer(
       "Exit status: 0 done, 3 the grasp failed (--wait), 4 sg-grasp refused the command "
-      "(its reason on stderr), 1 any other error.");
+      "(its reason on stderr; also an unauthenticated one), 2 no lab key, 1 any other error.");
   app.require_subcommand(1);
   auto* track = app.add_subcommand("track", "follow the predicted ball at a stand-off above it");
   track->add_option("--standoff", standoff, "m above the ball (default: sg-grasp's, 0.10)")
@@ -143,6 +150,8 @@ int main(int argc, char** argv) {
                            : *abort   ? Cmd::COMMAND_ABORT
                                       : Cmd::COMMAND_HOME;
     (void)home;
-    return send(bus, command, standoff, wait, timeout);
+    return sg::auth::with_lab_access(app.get_name(), key_options, [&](sg::auth::LabAccess& lab) {
+      return send(bus, lab, command, standoff, wait, timeout);
+    });
   });
 }

@@ -5,11 +5,15 @@
 //
 //   sg-grasp                         # then: sg-grasp-ctl track; sg-grasp-ctl grasp
 //   sg-grasp --no-prediction         # aim at the last measured position (the baseline)
+//
+// Its ARM_COMMAND are signed with the lab key, and GRASP_COMMAND must be (--key, default
+// $SG_LAB_KEY or ~/.config/stereograsp/lab.key; docs/security.md).
 
 #include <spdlog/spdlog.h>
 
 #include <chrono>
 
+#include "auth/lab_access.hpp"
 #include "grasp/grasp_machine.hpp"
 #include "grasp/grasp_node.hpp"
 #include "grasp/grasp_settings.hpp"
@@ -27,10 +31,11 @@
 namespace {
 
 int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
-        const sg::grasp::GraspSettings& settings, double status_rate) {
+        const sg::grasp::GraspSettings& settings, double status_rate, sg::auth::LabAccess& lab) {
   sg::install_shutdown_handlers();
   sg::Bus bus(url);
   sg::grasp::GraspNode node(geometry, settings, sg::now_utime(), 1.0 / status_rate);
+  if (lab.key()) node.require_signed_commands(*lab.key(), "GRASP_COMMAND");
   bus.subscribe<stereograsp::trajectory_t>("OBJECT_TRAJECTORY", [&](const auto& m, const auto&) {
     const std::string why = node.on_trajectory(m, sg::now_utime());
     if (!why.empty()) bus.note_refused("OBJECT_TRAJECTORY", why);  // counted, logged sparingly
@@ -50,7 +55,11 @@ int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
   while (!sg::shutdown_requested()) {
     bus.handle(std::chrono::milliseconds(10));
     const sg::grasp::GraspNode::Output out = node.poll(sg::now_utime());
-    if (out.arm_command) bus.publish("ARM_COMMAND", *out.arm_command);
+    if (out.arm_command) {
+      stereograsp::arm_cmd_t command = *out.arm_command;
+      lab.sign("ARM_COMMAND", command);
+      bus.publish("ARM_COMMAND", command);
+    }
     if (out.status) bus.publish("GRASP_STATUS", *out.status);
     if (!out.changed_summary.empty()) spdlog::info("{}", out.changed_summary);
   }
@@ -66,6 +75,8 @@ int main(int argc, char** argv) {
       "sg-grasp"};
   sg::CommonOptions common;
   sg::add_common_options(app, common);
+  sg::auth::KeyOptions key_options;
+  sg::auth::add_key_options(app, key_options);
   const auto keys = sg::declared_keys(sg::grasp::read_grasp_settings);
   common.flags.add_switch(app, "--no-prediction", "grasp.use_prediction", "false",
                           "aim at the last measured position instead of the predicted one");
@@ -77,7 +88,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   return sg::run_program(app, argc, argv, [&] {
     const sg::Config config = sg::load_common(common);
-    return run(common.lcm_url, sg::arm::load_arm_geometry(config),
-               sg::grasp::read_grasp_settings(config), status_rate);
+    const sg::arm::ArmGeometry geometry = sg::arm::load_arm_geometry(config);
+    const sg::grasp::GraspSettings settings = sg::grasp::read_grasp_settings(config);
+    return sg::auth::with_lab_access(app.get_name(), key_options, [&](sg::auth::LabAccess& lab) {
+      return run(common.lcm_url, geometry, settings, status_rate, lab);
+    });
   });
 }

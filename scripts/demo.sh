@@ -23,6 +23,10 @@
 #
 # The bus is LCM's default (or $LCM_DEFAULT_URL), so `scripts/spy.sh` in another terminal shows
 # the channels while the demo runs.
+#
+# Commands are signed (docs/security.md): the demo uses $SG_LAB_KEY or
+# ~/.config/stereograsp/lab.key when it exists, else a key of its own that sg-keygen makes in a
+# temporary folder for the session (removed at the end).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -62,8 +66,24 @@ url_args=()
 logger_url=${LCM_DEFAULT_URL:-udpm://239.255.76.67:7667?ttl=0}
 
 pids=()
-cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done; }
+key_dir=""
+cleanup() {
+  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
+  [ -z "$key_dir" ] || rm -rf "$key_dir"
+}
 trap cleanup EXIT
+
+# The lab key that signs ARM_COMMAND and GRASP_COMMAND: every program below reads $SG_LAB_KEY.
+default_key=${SG_LAB_KEY:-${HOME:-/nonexistent}/.config/stereograsp/lab.key}
+if [ -e "$default_key" ]; then
+  export SG_LAB_KEY="$default_key"
+  echo "demo: signing commands with the lab key $SG_LAB_KEY"
+else
+  key_dir=$(mktemp -d)
+  export SG_LAB_KEY="$key_dir/lab.key"
+  "$bin/sg-keygen" "$SG_LAB_KEY" > /dev/null
+  echo "demo: no lab key at $default_key; signing with a session key ($SG_LAB_KEY, sg-keygen)"
+fi
 
 logger_args=(--lcm-url="$logger_url" --quiet)
 [ "$with_images" -eq 1 ] || logger_args+=(-v -c 'CAMERA_.*')   # everything but the images

@@ -7,7 +7,8 @@
 //        the arm holds the ball; sg-calibrate moves it (ARM_COMMAND) through a grid of 18
 //        positions (the `calibrate_robot:` section of --config, or the flags), waits for
 //        ARM_STATUS to report each arrival, averages BLOB_LEFT/RIGHT there, and solves the DLT of
-//        both cameras in the robot frame; a stop the arm refuses or the cameras miss is skipped
+//        both cameras in the robot frame; a stop the arm refuses or the cameras miss is skipped;
+//        its ARM_COMMAND are signed with the lab key (--key, docs/security.md)
 //   sg-calibrate register --calibration cams.yaml --points marks.csv --out robot.yaml
 //        each CSV line X,Y,Z,u_left,v_left,u_right,v_right: a point known in the robot frame and
 //        where both cameras see it; the calibration is moved into the robot's frame
@@ -21,6 +22,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "auth/lab_access.hpp"
 #include "common/bus.hpp"
 #include "common/clock.hpp"
 #include "common/message_types.hpp"
@@ -220,7 +222,7 @@ int warn_skipped(const std::vector<sg::vision::CalibrationStop>& stops) {
 }
 
 int run_robot(const std::string& url, const sg::vision::RobotCalibrationParams& params,
-              const std::string& out) {
+              const std::string& out, sg::auth::LabAccess& lab) {
   const double timeout_s = params.timeout;
   sg::install_shutdown_handlers();
   sg::Bus bus(url);
@@ -244,7 +246,11 @@ int run_robot(const std::string& url, const sg::vision::RobotCalibrationParams& 
                                  " s (is sg-arm-driver running?); nothing written");
       return true;
     }
-    if (auto t = cal.next_target()) bus.publish("ARM_COMMAND", command_to(*t, sg::now_utime()));
+    if (auto t = cal.next_target()) {
+      stereograsp::arm_cmd_t command = command_to(*t, sg::now_utime());
+      lab.sign("ARM_COMMAND", command);
+      bus.publish("ARM_COMMAND", command);
+    }
     const std::string progress = cal.progress();
     if (progress != last_progress) {
       spdlog::info("{}", progress);
@@ -306,12 +312,14 @@ CLI::App* add_checkerboard(CLI::App& app, Inputs& in) {
 }
 
 /// The robot subcommand: its flags stand for `calibrate_robot` keys (the flag wins).
-CLI::App* add_robot(CLI::App& app, Inputs& in, sg::ConfigFlags& flags) {
+CLI::App* add_robot(CLI::App& app, Inputs& in, sg::ConfigFlags& flags,
+                    sg::auth::KeyOptions& key_options) {
   CLI::App* robot = app.add_subcommand(
       "robot", "Arm-guided: the arm carries the ball through a grid (section 4)");
   robot->add_option("--out", in.out, "calibration file to write")->required();
   robot->add_option("--width", in.width, "image width (px)")->capture_default_str();
   robot->add_option("--height", in.height, "image height (px)")->capture_default_str();
+  sg::auth::add_key_options(*robot, key_options);  // its ARM_COMMAND are signed
   const auto keys = sg::declared_keys(sg::vision::load_robot_calibration_params);
   for (const char* key : {"frames_per_stop", "settle", "speed", "timeout", "box_min", "box_max",
                           "grid", "ball_offset", "tool_rpy"}) {
@@ -342,7 +350,8 @@ int main(int argc, char** argv) {
   Inputs in;
   CLI::App* dlt = add_dlt(app, in);
   CLI::App* board = add_checkerboard(app, in);
-  CLI::App* robot = add_robot(app, in, common.flags);
+  sg::auth::KeyOptions key_options;
+  CLI::App* robot = add_robot(app, in, common.flags, key_options);
   add_register(app, in);
   return sg::run_program(app, argc, argv, [&] {
     const sg::Config config = sg::load_common(common);
@@ -352,7 +361,9 @@ int main(int argc, char** argv) {
     if (*robot) {
       robot_params.image_width = in.width;
       robot_params.image_height = in.height;
-      return run_robot(common.lcm_url, robot_params, in.out);
+      return sg::auth::with_lab_access(app.get_name(), key_options, [&](auto& lab) {
+        return run_robot(common.lcm_url, robot_params, in.out, lab);
+      });
     }
     if (*dlt) return run_dlt(in.left, in.right, in.width, in.height, in.out);
     if (*board) return run_checkerboard(in.left, in.right, in.pattern, in.square, in.out);

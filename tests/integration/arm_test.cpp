@@ -1,6 +1,7 @@
 // sg-arm-driver and sg-c550-sim as processes on a real pseudo-terminal, over real LCM: a move, a
 // gripper cycle, a rejected target, latest-wins under a burst, recovery after a disconnect, and
-// sg-arm-ctl at the bench.
+// sg-arm-ctl at the bench. The test's commands are signed with the lab key in $SG_LAB_KEY (ctest
+// gives it; docs/security.md).
 
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -11,6 +12,7 @@
 #include <sstream>
 #include <thread>
 
+#include "auth/command_auth.hpp"
 #include "common/bus.hpp"
 #include "common/clock.hpp"
 #include "common/message_types.hpp"
@@ -122,6 +124,11 @@ class ArmRig {
   std::string command_log() const { return dir_ + "/commands.log"; }
   const std::string& url() const { return url_; }
   Bus& bus() { return bus_; }
+  /// Signs `c` with the lab key ($SG_LAB_KEY, as the driver reads it) and publishes it.
+  void command(arm_cmd_t c) {
+    signer_.sign("ARM_COMMAND", c);
+    bus_.publish("ARM_COMMAND", c);
+  }
   const arm_status_t& status() const { return status_; }
   const sim_arm_state_t& truth() const { return truth_; }
   bool saw_disconnected() const { return saw_disconnected_; }
@@ -154,6 +161,7 @@ class ArmRig {
   std::string dir_;
   std::string url_;
   Bus bus_;
+  auth::CommandSigner signer_{auth::LabKey::load(auth::default_key_path()), "arm_test"};
   std::unique_ptr<Child> sim_;
   std::unique_ptr<Child> driver_;
   arm_status_t status_{};
@@ -172,7 +180,7 @@ TEST(ArmProcesses, MoveGripperCycleAndRejection) {
   ASSERT_TRUE(multicast_available(7916));
   ArmRig rig(7916, {});
   ASSERT_TRUE(rig.wait_connected());
-  rig.bus().publish("ARM_COMMAND", move_to(1, 0.45, 0.10, 0.30));
+  rig.command(move_to(1, 0.45, 0.10, 0.30));
   ASSERT_TRUE(rig.wait_executed(1)) << rig.status().error << rig.status().rejection_reason;
   EXPECT_LT(tool_error(rig.status(), 0.45, 0.10, 0.30), 1e-3);
   ASSERT_TRUE(rig.wait_until(
@@ -185,12 +193,12 @@ TEST(ArmProcesses, MoveGripperCycleAndRejection) {
   EXPECT_GT(rig.status().interaction_time, 0.3);
 
   // Gripper: close, then open; the status and the simulator's finger opening follow.
-  rig.bus().publish("ARM_COMMAND", gripper(2, arm_cmd_t::GRIPPER_CLOSE));
+  rig.command(gripper(2, arm_cmd_t::GRIPPER_CLOSE));
   ASSERT_TRUE(rig.wait_executed(2));
   EXPECT_TRUE(
       rig.wait_until([&] { return rig.status().gripper == arm_status_t::GRIPPER_CLOSED; }, 5s));
   EXPECT_TRUE(rig.wait_until([&] { return rig.truth().gripper_opening < 1e-3; }, 5s));
-  rig.bus().publish("ARM_COMMAND", gripper(3, arm_cmd_t::GRIPPER_OPEN));
+  rig.command(gripper(3, arm_cmd_t::GRIPPER_OPEN));
   ASSERT_TRUE(rig.wait_executed(3));
   EXPECT_TRUE(
       rig.wait_until([&] { return rig.status().gripper == arm_status_t::GRIPPER_OPEN; }, 5s));
@@ -198,12 +206,12 @@ TEST(ArmProcesses, MoveGripperCycleAndRejection) {
 
   // Out of reach inside the workspace box: rejected with a reason, nothing reaches the controller.
   const size_t before = starting_with(logged_commands(rig.command_log()), "MA").size();
-  rig.bus().publish("ARM_COMMAND", move_to(4, 0.85, 0.85, 1.20));
+  rig.command(move_to(4, 0.85, 0.85, 1.20));
   ASSERT_TRUE(rig.wait_until([&] { return rig.status().last_rejected_sequence == 4; }, 10s));
   EXPECT_FALSE(rig.status().rejection_reason.empty());
   EXPECT_EQ(rig.status().last_executed_sequence, 3);
   // A stale sequence number is refused too.
-  rig.bus().publish("ARM_COMMAND", move_to(2, 0.40, 0.0, 0.40));
+  rig.command(move_to(2, 0.40, 0.0, 0.40));
   ASSERT_TRUE(rig.wait_until([&] { return rig.status().last_rejected_sequence == 2; }, 10s));
   // A window, not a wait: no MA may reach the controller in the second after the refusals.
   std::this_thread::sleep_for(1s);
@@ -218,7 +226,7 @@ TEST(ArmProcesses, LatestWinsUnderABurst) {
   ASSERT_TRUE(rig.wait_connected());
   for (int i = 1; i <= 100; ++i) {
     const double a = 0.01 * i;
-    rig.bus().publish("ARM_COMMAND", move_to(i, 0.50 * std::cos(a), 0.50 * std::sin(a), 0.30));
+    rig.command(move_to(i, 0.50 * std::cos(a), 0.50 * std::sin(a), 0.30));
     std::this_thread::sleep_for(2ms);  // pacing: the burst (100 in 0.2 s) is what is under test
   }
   ASSERT_TRUE(rig.wait_executed(100, 30s)) << rig.status().error;
@@ -240,8 +248,7 @@ TEST(ArmProcesses, RecoversAfterADisconnect) {
   while (std::chrono::steady_clock::now() - start < 7s) {
     ++sequence;
     const double a = 0.2 * static_cast<double>(sequence);
-    rig.bus().publish("ARM_COMMAND",
-                      move_to(sequence, 0.50 * std::cos(a), 0.50 * std::sin(a), 0.35));
+    rig.command(move_to(sequence, 0.50 * std::cos(a), 0.50 * std::sin(a), 0.35));
     handle_for(rig.bus(), 1s);  // pacing: one command a second, across the line's outage
   }
   ASSERT_TRUE(rig.wait_executed(sequence, 30s)) << rig.status().error;

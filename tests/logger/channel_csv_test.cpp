@@ -156,10 +156,13 @@ TEST(ChannelCsv, SeveralTypesExactFiles) {
     // Written as they come: the rows are on disk after flush(), before destruction.
     EXPECT_EQ(test::count_lines(test::read_text(dir + "/GRASP_COMMAND.csv")), 3);
   }
+  // auth_counter and the 32 bytes of auth_tag (unsigned: zero) follow the sender.
+  std::string auth_names = ",auth_counter", auth_zeros = ",0";
+  for (int i = 0; i < 32; ++i) auth_names += ",auth_tag_" + std::to_string(i), auth_zeros += ",0";
   EXPECT_EQ(test::read_text(dir + "/GRASP_COMMAND.csv"),
-            "recv_utime,utime,sequence,command,standoff,sender\n"
-            "100,5,7,2,0.125,\"op, \"\"bob\"\"\"\n"
-            "103,5,8,2,0.125,\"\"\n");
+            "recv_utime,utime,sequence,command,standoff,sender" + auth_names + "\n" +
+                "100,5,7,2,0.125,\"op, \"\"bob\"\"\"" + auth_zeros + "\n" +
+                "103,5,8,2,0.125,\"\"" + auth_zeros + "\n");
   EXPECT_EQ(test::read_text(dir + "/OBJECT_TRAJECTORY.csv"),
             "recv_utime,utime,source_utime,start_utime,period_us,num_points,position_0_0,"
             "position_0_1,position_0_2,position_1_0,position_1_1,position_1_2,occluded_samples,"
@@ -171,7 +174,7 @@ TEST(ChannelCsv, SeveralTypesExactFiles) {
   // The quoted string reads back with its comma and quotes.
   const auto rows = parse_csv(test::read_text(dir + "/GRASP_COMMAND.csv"));
   ASSERT_EQ(rows.size(), 3u);
-  ASSERT_EQ(rows[1].size(), 6u);
+  ASSERT_EQ(rows[1].size(), 6u + 33u);
   EXPECT_EQ(rows[1][5], "op, \"bob\"");
 }
 

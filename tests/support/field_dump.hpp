@@ -34,6 +34,9 @@ class FieldDump {
       fields_[name] = "s:" + hex(value.data(), value.size());
     } else if constexpr (std::is_same_v<T, std::vector<uint8_t>>) {
       fields_[name] = "x:" + hex(value.data(), value.size());
+    } else if constexpr (std::is_array_v<T> &&
+                         std::is_same_v<std::remove_extent_t<T>, uint8_t>) {  // byte x[n], as Java
+      fields_[name] = "x:" + hex(value, std::extent_v<T>);
     } else if constexpr (std::is_array_v<T>) {
       for (size_t i = 0; i < std::extent_v<T>; ++i)
         add(name + "[" + std::to_string(i) + "]", value[i]);

@@ -1,0 +1,58 @@
+#include "auth/lab_access.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+#include <filesystem>
+
+namespace sg::auth {
+
+void add_key_options(CLI::App& app, KeyOptions& options) {
+  CLI::Option* key = app.add_option(
+      "--key", options.path,
+      "lab key file that signs and checks commands, mode 0600 (default: $SG_LAB_KEY, else "
+      "~/.config/stereograsp/lab.key; make one with sg-keygen)");
+  CLI::Option* insecure = app.add_flag(
+      "--insecure-no-key", options.insecure,
+      "run without a lab key: send commands unsigned and accept unsigned ones (anyone on the "
+      "network can then command the arm)");
+  key->excludes(insecure);
+}
+
+LabAccess::LabAccess(std::optional<LabKey> key, std::string sender, VerifierSettings settings)
+    : key_(std::move(key)), sender_(std::move(sender)) {
+  if (key_) {
+    signer_.emplace(*key_, sender_);
+    verifier_.emplace(*key_, settings);
+  }
+}
+
+int with_lab_access(const std::string& program, const KeyOptions& options,
+                    const std::function<int(LabAccess&)>& body) {
+  std::optional<LabKey> key;
+  if (options.insecure) {
+    spdlog::warn(
+        "INSECURE: running without a lab key (--insecure-no-key): commands go unsigned and "
+        "unsigned ones are obeyed; anyone on the network can command the arm");
+  } else {
+    std::string path;
+    try {
+      path = options.path.empty() ? default_key_path() : options.path;
+      key = LabKey::load(path);
+    } catch (const LabKeyError& e) {
+      std::error_code ec;
+      const bool missing = path.empty() || !std::filesystem::exists(path, ec);
+      std::fprintf(stderr, "%s: error: %s; %s\n", program.c_str(), e.what(),
+                   missing ? ("make one with `sg-keygen " + path +
+                              "` and copy it to every lab machine (mode 0600), give --key PATH, "
+                              "or run with --insecure-no-key")
+                                 .c_str()
+                           : "fix it, give --key PATH, or run with --insecure-no-key");
+      return kExitNoKey;
+    }
+  }
+  LabAccess lab(std::move(key), program);
+  return body(lab);
+}
+
+}  // namespace sg::auth

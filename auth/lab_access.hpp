@@ -1,0 +1,87 @@
+#pragma once
+
+/// What a program that sends or receives commands holds of the lab key: a signer for what it
+/// sends and a verifier for what it receives — or, with `--insecure-no-key`, neither: it sends
+/// unsigned and accepts everything, after a loud warning. Every such program takes the same two
+/// flags (`--key PATH`, default $SG_LAB_KEY else ~/.config/stereograsp/lab.key, and
+/// `--insecure-no-key`), and without a usable key and without the flag it exits 2 with one line
+/// that says how to make one.
+///
+///     sg::auth::KeyOptions key_options;
+///     sg::auth::add_key_options(app, key_options);
+///     return sg::run_program(app, argc, argv, [&] {
+///       const sg::Config config = sg::load_common(common);       // logging is set up
+///       return sg::auth::with_lab_access(app.get_name(), key_options, [&](auto& lab) {
+///         lab.sign("ARM_COMMAND", command);                        // a sender
+///         const std::string why = lab.refusal("ARM_COMMAND", command, sg::now_utime());
+///         return 0;                                                // why: "" when accepted
+///       });
+///     });
+
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "auth/command_auth.hpp"
+#include "auth/lab_key.hpp"
+
+namespace sg::auth {
+
+/// The exit code of a program started without a usable key and without --insecure-no-key.
+constexpr int kExitNoKey = 2;
+
+/// --key and --insecure-no-key.
+struct KeyOptions {
+  std::string path;       ///< --key; "" means default_key_path()
+  bool insecure = false;  ///< --insecure-no-key
+};
+
+/// Adds --key PATH and --insecure-no-key (which exclude each other) to `app` or a subcommand.
+void add_key_options(CLI::App& app, KeyOptions& options);
+
+/// The signer and verifier of one program, or neither (insecure).
+class LabAccess {
+ public:
+  /// With a key: signs as `sender`, verifies with `settings`. Without: signs nothing (only sets
+  /// the sender) and accepts every command.
+  LabAccess(std::optional<LabKey> key, std::string sender, VerifierSettings settings = {});
+
+  bool secure() const { return key_.has_value(); }
+  const std::optional<LabKey>& key() const { return key_; }
+  /// The verifier (nullptr when insecure), for its counts.
+  const CommandVerifier* verifier() const { return verifier_ ? &*verifier_ : nullptr; }
+
+  /// Signs `command` for `channel` (insecure: sets its sender only).
+  template <class M>
+  void sign(const std::string& channel, M& command) {
+    if (signer_) {
+      signer_->sign(channel, command);
+    } else {
+      command.sender = sender_;
+    }
+  }
+
+  /// "" when `command` may be obeyed (always when insecure), else "unauthenticated: <why>".
+  template <class M>
+  std::string refusal(const std::string& channel, const M& command, int64_t now_utime) {
+    if (!verifier_) return "";
+    const Verification v = verifier_->verify(channel, command, now_utime);
+    return v.accepted() ? "" : "unauthenticated: " + v.reason;
+  }
+
+ private:
+  std::optional<LabKey> key_;
+  std::string sender_;
+  std::optional<CommandSigner> signer_;
+  std::optional<CommandVerifier> verifier_;
+};
+
+/// Loads the key that `options` name and runs `body` with the program's LabAccess, signing as
+/// `program`. With --insecure-no-key, first logs the warning (spdlog warn) "INSECURE: ...". A
+/// key that cannot be loaded: "<program>: error: lab key PATH: <why>; make one with ..." on
+/// stderr and kExitNoKey. Other exceptions pass through (run_program reports them).
+int with_lab_access(const std::string& program, const KeyOptions& options,
+                    const std::function<int(LabAccess&)>& body);
+
+}  // namespace sg::auth
