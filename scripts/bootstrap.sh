@@ -38,7 +38,6 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev       # tests and benchmarks
   nlohmann-json3-dev                               # sg-report's report.json (and its tests)
   libsodium-dev pkg-config                         # signed commands (auth/: HMAC, the lab key)
-  libsodium-dev pkg-config                         # signed commands (auth/: HMAC, the lab key)
   gnuplot-nox                                      # sg-report's PNG figures (pngcairo terminal)
   iproute2 util-linux                              # ip and unshare for scripts/multicast.sh
 )
