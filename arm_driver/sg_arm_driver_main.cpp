@@ -32,6 +32,7 @@ int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
         const sg::arm::ArmDriverSettings& s, sg::auth::LabAccess& lab) {
   sg::install_shutdown_handlers();
   sg::Bus bus(url);
+  bus.announce("sg-arm-driver");
   sg::arm::SerialPort::open(s.device, s.serial).reset();  // fail now, clearly, on a bad path
   sg::arm::ArmDriver driver(geometry, s.driver, [&] {
     return std::unique_ptr<sg::arm::ByteStream>(sg::arm::SerialPort::open(s.device, s.serial));

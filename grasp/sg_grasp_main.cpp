@@ -34,6 +34,7 @@ int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
         const sg::grasp::GraspSettings& settings, double status_rate, sg::auth::LabAccess& lab) {
   sg::install_shutdown_handlers();
   sg::Bus bus(url);
+  bus.announce("sg-grasp");
   sg::grasp::GraspNode node(geometry, settings, sg::now_utime(), 1.0 / status_rate);
   if (lab.key()) node.require_signed_commands(*lab.key(), "GRASP_COMMAND");
   bus.subscribe<stereograsp::trajectory_t>("OBJECT_TRAJECTORY", [&](const auto& m, const auto&) {

@@ -69,9 +69,8 @@ Candidate read_candidate(FILE* f, int64_t q, int64_t file_size, EventHeader& h) 
 }
 
 /// True when a whole, plausible event starts exactly at `q` (its magic there, its lengths within
-/// bounds and the file); the file is left positioned at `q`.
-bool event_at(FILE* f, int64_t q, int64_t file_size) {
-  EventHeader h;
+/// bounds and the file, its header then in `h`); the file is left positioned at `q`.
+bool event_at(FILE* f, int64_t q, int64_t file_size, EventHeader& h) {
   const bool good = read_candidate(f, q, file_size, h) == Candidate::kEvent;
   fseeko(f, q, SEEK_SET);
   return good;
@@ -128,7 +127,8 @@ bool LogReader::next(LogRecord& out) {
   const lcm::LogEvent* event = nullptr;
   // LCM's reader trusts the lengths in a header; it is given only an event checked here. Anything
   // else (garbage, a damaged header) goes to recover(), which reads around it.
-  if (end_of_last_ < file_size_ && event_at(f, end_of_last_, file_size_)) {
+  EventHeader header;
+  if (end_of_last_ < file_size_ && event_at(f, end_of_last_, file_size_, header)) {
     QuietLcm quiet;
     event = log_->readNextEvent();
   }
@@ -142,12 +142,13 @@ bool LogReader::next(LogRecord& out) {
     report_progress(true);
     return false;
   }
-  const int64_t after = static_cast<int64_t>(ftello(f));
-  const int64_t start =
-      after - kHeaderSize - static_cast<int64_t>(event->channel.size()) - event->datalen;
-  if (start > end_of_last_)
-    add_problem(LogProblem::Kind::kSkipped, end_of_last_, start - end_of_last_);
-  end_of_last_ = after;
+  // The event LCM read is the one checked at end_of_last_. Its end comes from the header, not
+  // from the file position: LCM reads 4 bytes past an event to look for the next magic and does
+  // not step back when fewer than 4 are left, and it returns a channel with a NUL inside as
+  // shorter than it is on disk (both found by fuzz/log_reader_fuzz).
+  const int64_t start = end_of_last_;
+  end_of_last_ = start + header.event_size();
+  fseeko(f, end_of_last_, SEEK_SET);
   out.channel = event->channel;
   out.recv_utime = event->timestamp;
   out.event_number = event->eventnum;

@@ -113,6 +113,7 @@ int run_lcm(sg::Bus& bus, StereoVision& vision, const Options& o) {
   };
   bus.subscribe<image_t>("CAMERA_LEFT", on_image);
   bus.subscribe<image_t>("CAMERA_RIGHT", on_image);
+  bus.announce("sg-vision");  // after subscribing: the first PROCESS_STATUS says it listens
   spdlog::info("waiting for CAMERA_LEFT and CAMERA_RIGHT");
   bus.spin([&] { return o.max_frames == 0 || frames < o.max_frames; });
   vision.report(pairer.unmatched(), bad + bus.decode_errors());
@@ -269,7 +270,6 @@ int main(int argc, char** argv) {
           "--publish-images republishes frames from cameras or files, not from the bus");
     sg::install_shutdown_handlers();
     sg::Bus bus(common.lcm_url);
-    bus.announce("sg-vision");
     const cv::Size size = calibration
                               ? cv::Size(calibration->left.width(), calibration->left.height())
                               : cv::Size(o.width, o.height);

@@ -192,7 +192,7 @@ TEST(Bus, ZeroLengthStringIsRefusedNotFatal) {
   stereograsp::arm_cmd_t c{};
   c.sender = "x";
   std::vector<uint8_t> bytes = encode_message(c);
-  const size_t at = bytes.size() - 2 - 4;
+  const size_t at = bytes.size() - 40 - 2 - 4;
   bytes[at] = bytes[at + 1] = bytes[at + 2] = bytes[at + 3] = 0;
   bus.publish_raw("ARM_COMMAND", bytes.data(), static_cast<int>(bytes.size()));
   bus.publish("ARM_COMMAND", c);

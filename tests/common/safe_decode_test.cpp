@@ -68,9 +68,9 @@ void put_int32(std::vector<uint8_t>& b, size_t at, uint32_t v) {
   for (int i = 0; i < 4; ++i) b[at + i] = static_cast<uint8_t>(v >> (24 - 8 * i));
 }
 
-/// The byte offset of the int32 just before the string field at the end of an arm_cmd_t.
+/// The byte offset of the int32 length of an arm_cmd_t's sender (then auth_counter, auth_tag[32]).
 size_t sender_length_offset(const arm_cmd_t& c) {
-  return encode_message(c).size() - 4 - (c.sender.size() + 1);
+  return encode_message(c).size() - 40 - 4 - (c.sender.size() + 1);
 }
 
 template <class M>
@@ -147,12 +147,12 @@ TEST(SafeDecode, UnterminatedAndOverlongStringsAreRefused) {
   arm_cmd_t c{};
   c.sender = "abc";
   std::vector<uint8_t> bytes = encode_message(c);
-  bytes.back() = 'x';
+  bytes[bytes.size() - 41] = 'x';
   arm_cmd_t m{};
   EXPECT_NE(safe_decode(bytes.data(), static_cast<int64_t>(bytes.size()), m).reason.find("NUL"),
             std::string::npos);
-  bytes.back() = 0;
-  put_int32(bytes, sender_length_offset(c), 5);  // one more than there is
+  bytes[bytes.size() - 41] = 0;
+  put_int32(bytes, sender_length_offset(c), 4 + 40 + 1);  // one more than there is
   EXPECT_NE(safe_decode(bytes.data(), static_cast<int64_t>(bytes.size()), m).reason.find("left"),
             std::string::npos);
 }

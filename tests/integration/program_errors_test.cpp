@@ -59,7 +59,7 @@ TEST(ProgramErrors, MalformedConfigValue) {
                      path + ":2:12: key 'bus_check.rate_hz': expected a number, got 'fast'"));
   const std::string negative = write("neg.yaml", "bus_check:\n  count: -5\n");
   EXPECT_TRUE(one_line_error(bus_check({"send", "--config", negative}),
-                             negative + ":2:10: key 'bus_check.count': must not be negative"));
+                             negative + ":2:10: key 'bus_check.count': must be in [0, 1000000000], got -5"));
 }
 
 // A file that is not YAML at all is refused with its line.

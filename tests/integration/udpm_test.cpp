@@ -23,11 +23,11 @@ TEST(Udpm, ThousandMessagesAt100HzBetweenProcessesNoneLost) {
   const ProcessResult sender = run(
       {program("sg-bus-check"), "send", "--count", "1000", "--rate", "100", "--lcm-url", url}, 60s);
   ASSERT_EQ(sender.exit_code, 0) << sender.err;
-  EXPECT_NE(sender.out.find("sent 1000 messages of 9 types"), std::string::npos) << sender.out;
+  EXPECT_NE(sender.out.find("sent 1000 messages of 10 types"), std::string::npos) << sender.out;
   const ProcessResult received = receiver.wait(30s);
   EXPECT_FALSE(received.timed_out);
   EXPECT_EQ(received.exit_code, 0) << received.out << received.err;
-  EXPECT_NE(received.out.find("received 1000 of 1000 (0 lost) on 9 channels"), std::string::npos)
+  EXPECT_NE(received.out.find("received 1000 of 1000 (0 lost) on 10 channels"), std::string::npos)
       << received.out;
   EXPECT_NE(received.out.find("0 corrupt, 0 duplicate"), std::string::npos) << received.out;
 }

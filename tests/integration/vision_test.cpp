@@ -43,8 +43,11 @@ TEST(Vision, PositionsFromSimulatedCamerasMatchTheTruth) {
                                      [&](const auto& m, const auto&) { blobs += m.found; });
   Child vision({program("sg-vision"), "--calibration", dir + "/cams.yaml", "--frames", "30",
                 "--lcm-url", url});
-  ASSERT_TRUE(eventually([&] { return joined_bus(vision.pid(), kPort); }, 30s,
-                         "sg-vision to join the bus"));
+  bool listening = false;  // sg-vision announces itself once it has subscribed
+  bus.subscribe<stereograsp::process_status_t>(
+      "PROCESS_STATUS", [&](const auto& m, const auto&) { listening |= m.process == "sg-vision"; });
+  ASSERT_TRUE(eventually(
+      bus, [&] { return listening; }, 30s, "sg-vision's PROCESS_STATUS"));
   // A malformed image first: 640x480 BGR that holds 100 bytes.
   stereograsp::image_t bad{};
   bad.width = 640, bad.height = 480, bad.row_stride = 1920;
