@@ -57,7 +57,8 @@ template <class M, class V>
 void visit_fields(M& m, V& v) {
   SG_FIELD(utime); SG_FIELD(source_utime); SG_FIELD(target_utime); SG_FIELD(sequence);
   SG_FIELD(mode); SG_FIELD(position); SG_FIELD(orientation); SG_FIELD(joints); SG_FIELD(gripper);
-  SG_FIELD(speed); SG_FIELD(sender); SG_FIELD(auth_counter); SG_FIELD(auth_tag);
+  SG_FIELD(speed); SG_FIELD(take_over); SG_FIELD(sender); SG_FIELD(auth_counter);
+  SG_FIELD(auth_tag);
 }
 template <class M, class V>
   requires std::same_as<std::remove_const_t<M>, stereograsp::arm_status_t>
@@ -66,6 +67,7 @@ void visit_fields(M& m, V& v) {
   SG_FIELD(tool_orientation); SG_FIELD(gripper); SG_FIELD(last_received_sequence);
   SG_FIELD(last_executed_sequence); SG_FIELD(last_rejected_sequence); SG_FIELD(rejection_reason);
   SG_FIELD(source_utime); SG_FIELD(interaction_time); SG_FIELD(speed); SG_FIELD(error);
+  SG_FIELD(commander); SG_FIELD(driver_start_utime); SG_FIELD(watchdog);
 }
 template <class M, class V>
   requires std::same_as<std::remove_const_t<M>, stereograsp::grasp_command_t>
