@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "common/program.hpp"
+
 namespace sg::auth {
 
 void add_key_options(CLI::App& app, KeyOptions& options) {
@@ -51,7 +53,7 @@ int with_lab_access(const std::string& program, const KeyOptions& options,
       return kExitNoKey;
     }
   }
-  LabAccess lab(std::move(key), program);
+  LabAccess lab(std::move(key), instance_name(program));
   return body(lab);
 }
 

@@ -2,6 +2,7 @@
 
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -9,6 +10,13 @@
 #include "common/bus.hpp"
 
 namespace sg {
+
+std::string instance_name(const std::string& program) {
+  char host[256] = {};
+  if (gethostname(host, sizeof host - 1) != 0 || host[0] == '\0')
+    std::snprintf(host, sizeof host, "unknown");
+  return program + "@" + host + ":" + std::to_string(getpid());
+}
 
 void add_common_options(CLI::App& app, CommonOptions& options) {
   app.add_option("--lcm-url", options.lcm_url,

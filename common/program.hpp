@@ -60,6 +60,10 @@ void add_common_options(CLI::App& app, CommonOptions& options);
 /// `bus.url`, else LCM's default. Throws ConfigError for a bad file.
 Config load_common(CommonOptions& options);
 
+/// "<program>@<host>:<pid>": this process among all on the bus, e.g. the sender of its commands
+/// (two sg-grasp, or a restarted one, are different commanders to sg-arm-driver's lease).
+std::string instance_name(const std::string& program);
+
 /// Sets spdlog's default logger: stderr, one line a record, prefixed with the program's name.
 void init_logging(const std::string& program, const std::string& level);
 

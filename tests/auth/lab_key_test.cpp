@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -12,6 +13,7 @@
 #include <fstream>
 
 #include "auth/lab_access.hpp"
+#include "common/program.hpp"
 #include "tests/support/subprocess.hpp"
 
 namespace sg::auth {
@@ -162,7 +164,9 @@ TEST(LabAccess, InsecureSignsNothingAndAcceptsAll) {
     stereograsp::arm_cmd_t c{};
     c.sequence = 3;
     lab.sign("ARM_COMMAND", c);
-    EXPECT_EQ(c.sender, "sg-test");
+    EXPECT_EQ(c.sender, sg::instance_name("sg-test"));  // sg-test@<host>:<pid>
+    EXPECT_EQ(c.sender.rfind("sg-test@", 0), 0u);
+    EXPECT_TRUE(c.sender.ends_with(":" + std::to_string(getpid())));
     EXPECT_EQ(c.auth_counter, 0);
     for (uint8_t b : c.auth_tag) EXPECT_EQ(b, 0);
     EXPECT_EQ(lab.refusal("ARM_COMMAND", c, 1'000'000), "");

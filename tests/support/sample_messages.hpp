@@ -90,6 +90,7 @@ inline void make_consistent(stereograsp::trajectory_t& m) {
 }
 inline void make_consistent(stereograsp::blob_t& m) { m.found = m.found != 0; }
 inline void make_consistent(stereograsp::point3_t& m) { m.visible = m.visible != 0; }
+inline void make_consistent(stereograsp::arm_cmd_t& m) { m.take_over = m.take_over != 0; }
 inline void make_consistent(stereograsp::sim_arm_state_t& m) {
   m.holding_object = m.holding_object != 0;
 }
