@@ -40,6 +40,7 @@ packages=(
   libsodium-dev pkg-config                         # signed commands (auth/: HMAC, the lab key)
   gnuplot-nox                                      # sg-report's PNG figures (pngcairo terminal)
   iproute2 util-linux                              # ip and unshare for scripts/multicast.sh
+  iptables faketime                                # fault injection: packet loss, clock skew
 )
 # Only for scripts/fuzz.sh: clang with libFuzzer, ASan and UBSan runtimes (libclang-rt-dev),
 # and llvm-symbolizer (llvm) for file:line in sanitizer reports.
