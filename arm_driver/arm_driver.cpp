@@ -60,6 +60,7 @@ void set_joints(const ArmGeometry& geometry, const Joints& q, Status& status) {
 ArmDriver::ArmDriver(ArmGeometry geometry, DriverSettings settings, DeviceOpener open_device,
                      Clock& clock)
     : validator_(std::move(geometry)),
+      lease_(settings.commander_timeout),
       settings_(settings),
       open_device_(std::move(open_device)),
       clock_(clock) {
@@ -69,6 +70,7 @@ ArmDriver::ArmDriver(ArmGeometry geometry, DriverSettings settings, DeviceOpener
   status_.last_executed_sequence = -1;
   status_.last_rejected_sequence = -1;
   status_.speed = 0;
+  status_.driver_start_utime = settings.start_utime != 0 ? settings.start_utime : clock.utime();
   set_joints(validator_.geometry(), current_, status_);
 }
 
@@ -79,22 +81,92 @@ void ArmDriver::update(F&& change) {
   ++version_;
 }
 
-void ArmDriver::submit(const Cmd& command) {
+Submission ArmDriver::submit(const Cmd& command) {
   std::lock_guard lock(mutex_);
+  const double t = clock_.now();
+  watchdog(t);  // a holder silent beyond the timeout is gone, whoever speaks now
+  const LeaseDecision lease = lease_.offer(command.sender, command.mode, command.take_over, t);
+  if (lease.verdict == LeaseVerdict::kRefused) return refuse_by_lease(command, lease.reason);
+  if (lease.changed) note_lease_change(command.sender, lease);
+  if (lease.verdict == LeaseVerdict::kRenewed || lease.verdict == LeaseVerdict::kReleased) {
+    return {Submission::kLease, ""};
+  }
+  Submission result = queue(command);
+  clock_.notify();
+  return result;
+}
+
+void ArmDriver::note_lease_change(const std::string& sender, const LeaseDecision& lease) {
+  if (!lease.taken_from.empty()) {
+    spdlog::warn("'{}' takes the arm over from '{}'", sender, lease.taken_from);
+  } else if (lease_.held()) {
+    spdlog::info("'{}' commands the arm", sender);
+  } else {
+    spdlog::info("'{}' releases the arm", sender);
+  }
+  status_.commander = lease_.holder();
+  if (lease_.held()) status_.last_received_sequence = validator_.last_sequence(lease_.holder());
+  ++version_;
+}
+
+Submission ArmDriver::refuse_by_lease(const Cmd& command, const std::string& why) {
+  spdlog::debug("refused command {} (mode {}) from '{}': {}", command.sequence, int{command.mode},
+                command.sender, why);
+  if (command.mode != Cmd::MODE_HEARTBEAT && command.mode != Cmd::MODE_RELEASE) {
+    status_.last_rejected_sequence = command.sequence;  // sg-arm-ctl reads its refusal here
+    status_.rejection_reason = why;
+    ++version_;
+  }
+  return {Submission::kRefused, why};
+}
+
+Submission ArmDriver::queue(const Cmd& command) {
   const Joints reference =
       pending_ && pending_->moves_arm() ? pending_->joints : commanded_.value_or(current_);
   ValidationResult result = validator_.validate(command, reference);
-  status_.last_received_sequence = command.sequence;
-  if (result.target) {
-    if (pending_) spdlog::debug("command {} replaces {}", command.sequence, pending_->sequence);
-    pending_ = std::move(*result.target);
-  } else {
+  if (command.sender == lease_.holder())
+    status_.last_received_sequence = validator_.last_sequence(command.sender);
+  ++version_;  // a duplicate too: the status goes out again, for a sender that missed it
+  if (result.duplicate) {
+    spdlog::debug("{}: ignored", result.reason);
+    return {Submission::kDuplicate, ""};
+  }
+  if (!result.target) {
     status_.last_rejected_sequence = command.sequence;
     status_.rejection_reason = result.reason;
-    spdlog::warn("rejected command {} from '{}': {}", command.sequence, command.sender,
-                 result.reason);
+    if (uint64_t held_back = 0; log_limit_.allow("rejected", clock_.now(), held_back)) {
+      spdlog::warn("rejected command {} from '{}': {}{}", command.sequence, command.sender,
+                   result.reason,
+                   held_back ? fmt::format(" ({} more rejections not logged)", held_back) : "");
+    }
+    return {Submission::kRejected, result.reason};
   }
+  if (pending_) spdlog::debug("command {} replaces {}", command.sequence, pending_->sequence);
+  pending_ = std::move(*result.target);
+  return {Submission::kQueued, ""};
+}
+
+void ArmDriver::watchdog(double t) {
+  if (!lease_.expired(t)) return;
+  const double silence = t - lease_.heard();
+  const std::string holder = lease_.expire(t);
+  status_.commander.clear();
   ++version_;
+  const bool pending_motion = pending_ && pending_->mode != Cmd::MODE_STOP;
+  if (status_.state != Status::STATE_MOVING && !pending_motion) {
+    spdlog::info("'{}' silent for {:.2f} s: the lease is free", holder, silence);
+    return;
+  }
+  ArmTarget stop;
+  stop.mode = Cmd::MODE_STOP;
+  stop.gripper = Cmd::GRIPPER_KEEP;  // never open the hand unasked
+  stop.sender = "watchdog";
+  stop.sequence = -1;
+  stop.internal = true;
+  if (!pending_ || pending_->mode != Cmd::MODE_STOP) pending_ = std::move(stop);
+  status_.watchdog = fmt::format("stopped: '{}' silent for {:.2f} s", holder, silence);
+  status_.error = status_.watchdog;
+  spdlog::warn("watchdog: {}", status_.watchdog);
   clock_.notify();
 }
 
@@ -102,7 +174,7 @@ void ArmDriver::refuse(const Cmd& command, const std::string& why) {
   std::lock_guard lock(mutex_);
   status_.last_rejected_sequence = command.sequence;
   status_.rejection_reason = why;
-  spdlog::warn("refused command {} from '{}': {}", command.sequence, command.sender, why);
+  spdlog::debug("refused command {} from '{}': {}", command.sequence, command.sender, why);
   ++version_;
 }
 
@@ -140,7 +212,10 @@ bool ArmDriver::connect(std::stop_token stop) {
       });
       spdlog::warn("cannot connect ({}); again in {:.1f} s", e.what(), wait);
       std::unique_lock lock(mutex_);
-      clock_.wait_until(lock, clock_.now() + wait, [] { return false; }, stop);
+      watchdog(clock_.now());
+      clock_.wait_until(lock, std::min(clock_.now() + wait, lease_.deadline()),
+                        [] { return false; }, stop);
+      watchdog(clock_.now());
       wait = std::min(wait * 2, settings_.reconnect_max);
     }
   }
@@ -206,24 +281,25 @@ void ArmDriver::requeue_rest(ArmTarget target) {
 void ArmDriver::record_executed(const ArmTarget& target) {
   attempts_ = 0;
   update([&](Status& s) {
-    s.last_executed_sequence = target.sequence;
+    if (!target.internal) s.last_executed_sequence = target.sequence;
     s.speed = speed_percent_ / 100.0;
     if (target.mode == Cmd::MODE_STOP || target.mode == Cmd::MODE_HOME) commanded_.reset();
     if (target.moves_arm()) commanded_ = target.joints;
     if (target.gripper == Cmd::GRIPPER_OPEN) s.gripper = Status::GRIPPER_OPEN;
     if (target.gripper == Cmd::GRIPPER_CLOSE) s.gripper = Status::GRIPPER_CLOSED;
     if (s.state == Status::STATE_ERROR) s.state = Status::STATE_MOVING;
-    s.error.clear();
+    if (!target.internal) s.error.clear();  // the watchdog's stop leaves its reason standing
   });
 }
 
 void ArmDriver::record_refusal(const ArmTarget& target, const std::string& why) {
   update([&](Status& s) {
+    s.error = "controller: " + why;
+    s.state = Status::STATE_ERROR;
+    if (target.internal) return;
     s.last_executed_sequence = target.sequence;  // delivered: it ran, and the controller refused
     s.last_rejected_sequence = target.sequence;
-    s.rejection_reason = "controller: " + why;
-    s.error = s.rejection_reason;
-    s.state = Status::STATE_ERROR;
+    s.rejection_reason = s.error;
   });
 }
 
@@ -276,8 +352,13 @@ void ArmDriver::requeue(ArmTarget target) {
   std::lock_guard lock(mutex_);
   if (pending_) return;  // a newer command is waiting: latest wins
   if (++attempts_ >= settings_.max_attempts) {
-    status_.last_rejected_sequence = target.sequence;
-    status_.rejection_reason = "not delivered after " + std::to_string(attempts_) + " attempts";
+    const std::string why = "not delivered after " + std::to_string(attempts_) + " attempts";
+    if (target.internal) {
+      status_.error = "watchdog stop " + why;
+    } else {
+      status_.last_rejected_sequence = target.sequence;
+      status_.rejection_reason = why;
+    }
     ++version_;
     attempts_ = 0;
     return;
@@ -287,9 +368,13 @@ void ArmDriver::requeue(ArmTarget target) {
 
 std::optional<ArmTarget> ArmDriver::wait_for_work(std::stop_token stop) {
   std::unique_lock lock(mutex_);
+  watchdog(clock_.now());  // first: a motion its commander abandoned must not start
   const bool moving = status_.state == Status::STATE_MOVING;
   const double poll = moving ? settings_.moving_poll : settings_.idle_poll;
-  clock_.wait_until(lock, clock_.now() + poll, [&] { return pending_.has_value(); }, stop);
+  // Wake when the commander's lease runs out too: the watchdog acts on time.
+  const double deadline = std::min(clock_.now() + poll, lease_.deadline());
+  clock_.wait_until(lock, deadline, [&] { return pending_.has_value(); }, stop);
+  watchdog(clock_.now());
   std::optional<ArmTarget> target = std::move(pending_);
   pending_.reset();
   return target;

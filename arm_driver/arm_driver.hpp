@@ -6,9 +6,19 @@
 /// (never a backlog), and no command is executed twice: a command counts as executed once its CR
 /// has reached the controller.
 ///
+/// One commander at a time (docs/arm.md, "One commander and the watchdog"): every command first
+/// passes the CommanderLease; only the holder's commands (and a STOP from anyone) reach the
+/// validator. MODE_HEARTBEAT and MODE_RELEASE touch only the lease: they consume no sequence and
+/// leave last_received_sequence and the pending slot alone. A command whose sequence equals its
+/// sender's last is a duplicate (a resend): ignored, executed once. The watchdog: when the holder
+/// has been silent for settings.commander_timeout the lease expires, and if the arm moves or a
+/// motion is pending the pending slot gets the driver's own STOP (ABORT, the gripper kept as it
+/// is), which ARM_STATUS reports in `watchdog` and `error` without a sequence of its own.
+///
 ///     ArmDriver driver(geometry, settings, [&] { return SerialPort::open(path, serial); });
 ///     std::jthread worker([&](std::stop_token stop) { driver.run(stop); });
-///     driver.submit(command);                       // from the bus thread
+///     Submission s = driver.submit(command);        // from the bus thread
+///     if (s.outcome == Submission::kRefused) bus.note_refused("ARM_COMMAND", s.reason);
 ///     auto [status, version] = driver.status();     // publish when version changes
 
 #include <functional>
@@ -20,6 +30,8 @@
 #include "arm_driver/byte_stream.hpp"
 #include "arm_driver/c550_link.hpp"
 #include "arm_driver/command_validator.hpp"
+#include "arm_driver/commander_lease.hpp"
+#include "arm_driver/log_limiter.hpp"
 #include "common/clock.hpp"
 #include "stereograsp/arm_status_t.hpp"
 
@@ -37,6 +49,25 @@ struct DriverSettings {
   /// The fastest the driver lets the arm move, a fraction of the joints' maximum speeds: the
   /// SPEED sent is min(command's speed, max_speed) in whole percent, 1..100 (a lab's cap).
   double max_speed = 1.0;
+  /// s of silence after which the commander loses the lease and the watchdog stops a moving arm:
+  /// about two controller interactions of 0.72-0.84 s.
+  double commander_timeout = 1.6;
+  /// When the driver process started, us since the Unix epoch (ARM_STATUS.driver_start_utime);
+  /// 0: the clock's utime() when the ArmDriver is made. Not a configuration key.
+  int64_t start_utime = 0;
+};
+
+/// What submit() made of a command.
+struct Submission {
+  enum Outcome {
+    kQueued,     ///< validated and in the slot (it replaced any pending command)
+    kDuplicate,  ///< its sequence equals its sender's last: ignored, not executed again
+    kRejected,   ///< the validator rejected it (status: last_rejected_sequence, the reason)
+    kRefused,    ///< the lease refused it: another sender commands the arm
+    kLease,      ///< a heartbeat or release: the lease renewed, taken or freed; nothing else
+  };
+  Outcome outcome = kQueued;
+  std::string reason;  ///< kRejected, kRefused: why
 };
 
 using DeviceOpener = std::function<std::unique_ptr<ByteStream>()>;
@@ -48,8 +79,10 @@ class ArmDriver {
   ArmDriver(ArmGeometry geometry, DriverSettings settings, DeviceOpener open_device,
             Clock& clock = system_clock());
 
-  /// Validates a command (bus thread) and puts it in the slot, or records its rejection.
-  void submit(const stereograsp::arm_cmd_t& command);
+  /// Passes a command (bus thread, authenticated already) through the lease, then validates it
+  /// and puts it in the slot, or records its rejection or refusal (a heartbeat's or release's
+  /// refusal is only returned: it has no sequence of its own to report).
+  Submission submit(const stereograsp::arm_cmd_t& command);
 
   /// Records a command refused before validation (e.g. unauthenticated: `why`) as rejected in
   /// the status, leaving what judges later commands untouched: last_received_sequence, the
@@ -67,6 +100,12 @@ class ArmDriver {
   double last_overhead() const;
 
  private:
+  Submission queue(const stereograsp::arm_cmd_t& command);
+  Submission refuse_by_lease(const stereograsp::arm_cmd_t& command, const std::string& why);
+  void note_lease_change(const std::string& sender, const LeaseDecision& decision);
+  /// Under mutex_: expires a silent commander's lease at `t`, and stops the arm if it moves or
+  /// a motion is pending.
+  void watchdog(double t);
   bool connect(std::stop_token stop);
   void disconnect(const std::string& why);
   void execute(ArmTarget target);
@@ -82,6 +121,8 @@ class ArmDriver {
   void update(F&& change);
 
   CommandValidator validator_;
+  CommanderLease lease_;
+  LogLimiter log_limit_;
   DriverSettings settings_;
   DeviceOpener open_device_;
   std::unique_ptr<ByteStream> stream_;

@@ -25,7 +25,13 @@ std::string metres(const Eigen::Vector3d& p) {
 
 ValidationResult CommandValidator::validate(const Cmd& command, const Joints& reference) {
   const auto last = last_sequence_.find(command.sender);
-  if (last != last_sequence_.end() && command.sequence <= last->second) {
+  if (last != last_sequence_.end() && command.sequence == last->second) {
+    return {std::nullopt,
+            "duplicate of command " + std::to_string(command.sequence) + " from '" +
+                command.sender + "'",
+            true};
+  }
+  if (last != last_sequence_.end() && command.sequence < last->second) {
     return reject("sequence " + std::to_string(command.sequence) + " from '" + command.sender +
                   "' is not newer than " + std::to_string(last->second));
   }
@@ -53,6 +59,11 @@ ValidationResult CommandValidator::validate(const Cmd& command, const Joints& re
     case Cmd::MODE_STOP: return {std::move(target), ""};
     default: return reject("unknown mode " + std::to_string(command.mode));
   }
+}
+
+int64_t CommandValidator::last_sequence(const std::string& sender) const {
+  const auto last = last_sequence_.find(sender);
+  return last == last_sequence_.end() ? -1 : last->second;
 }
 
 ValidationResult CommandValidator::cartesian(const Cmd& command, const Joints& reference,

@@ -1,7 +1,8 @@
 #pragma once
 
 /// Checks each ARM_COMMAND before anything reaches the serial line, and turns it into a joint
-/// target: finite numbers, a known mode, a speed in (0, 1], a sequence number newer than the last,
+/// target: finite numbers, a known mode, a speed in (0, 1], a sequence number newer than the last
+/// (equal: a duplicate, a resend of a command the driver already has, which is ignored),
 /// a tool position inside the workspace box, a pose the arm reaches within its joint limits (the
 /// inverse-kinematics solution nearest the reference joints). "The arm never gets a target
 /// outside its limits" (DESIGN.md, rule 5) is enforced here.
@@ -28,6 +29,9 @@ struct ArmTarget {
   double speed = 0.5;              ///< fraction of the joint speed limits
   int64_t source_utime = 0;
   std::string sender;
+  /// The driver's own command (the watchdog's STOP): no sender's sequence, so executing it
+  /// changes neither last_executed_sequence nor last_rejected_sequence.
+  bool internal = false;
   bool moves_arm() const {
     return mode == stereograsp::arm_cmd_t::MODE_CARTESIAN ||
            mode == stereograsp::arm_cmd_t::MODE_JOINTS;
@@ -36,7 +40,8 @@ struct ArmTarget {
 
 struct ValidationResult {
   std::optional<ArmTarget> target;
-  std::string reason;  ///< why it was rejected, when target is empty
+  std::string reason;      ///< why it was rejected, when target is empty
+  bool duplicate = false;  ///< the sequence equals its sender's last: ignored, not a rejection
 };
 
 class CommandValidator {
@@ -46,9 +51,13 @@ class CommandValidator {
   /// Checks `command`; `reference` is where the arm will be when the command runs (the pending
   /// target, else the current joints), from which the nearest IK solution is chosen. Sequence
   /// numbers are per sender (sg-grasp counts, sg-arm-ctl uses its clock); every command
-  /// received, accepted or not, advances its sender's last sequence number.
+  /// received, accepted or not, advances its sender's last sequence number. A sequence equal to
+  /// the sender's last is a duplicate (sg-grasp resending a command it fears was lost): no
+  /// target, `duplicate` set. Not for MODE_HEARTBEAT and MODE_RELEASE, which consume no sequence.
   ValidationResult validate(const stereograsp::arm_cmd_t& command, const Joints& reference);
   const ArmGeometry& geometry() const { return geometry_; }
+  /// The last sequence received from `sender`, -1 when none.
+  int64_t last_sequence(const std::string& sender) const;
 
  private:
   ValidationResult reject(std::string reason) const { return {std::nullopt, std::move(reason)}; }

@@ -39,6 +39,9 @@ ArmDriverSettings read_arm_driver_settings(const Config& config) {
            "fastest the driver lets the arm move, fraction of the joints' maximum speeds");
   a.number("reconnect_max", s.driver.reconnect_max, Range::closed(s.driver.reconnect_min, 3600),
            "s: the reconnect back-off doubles up to this");
+  a.number("commander_timeout", s.driver.commander_timeout, Range::closed(0.2, 60),
+           "s of silence after which the commander loses the lease and a moving arm is stopped "
+           "(ABORT, gripper kept)");
   a.done();
   return s;
 }

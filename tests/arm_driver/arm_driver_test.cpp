@@ -1,7 +1,8 @@
 // The driver core (ArmDriver, real code) against the C550 emulator model (sim/), both in this
 // process: the emulator runs in real (steady_clock) time behind a ByteStream adapter, with a short
 // interaction delay so that the tests are quick. Checks a Cartesian move, the gripper, a rejected
-// target, latest-wins under a burst of commands, and reconnection after the line goes down.
+// target, latest-wins under a burst of commands, and reconnection after the line goes down (with
+// a heartbeat going, as from a live commander: the watchdog stops an abandoned arm).
 
 #include "arm_driver/arm_driver.hpp"
 
@@ -258,7 +259,24 @@ class ArmDriverTest : public testing::Test {
                                           [this] { return bench_->open(); });
     worker_ = std::jthread([this](std::stop_token stop) { driver_->run(stop); });
   }
+  /// Sends a heartbeat from "test" every 0.2 s until the test ends, as a live commander does
+  /// (the tests across an outage last longer than the commander timeout of 1.6 s).
+  void keep_commanding() {
+    heartbeat_ = std::jthread([this](std::stop_token stop) {
+      Cmd beat{};
+      beat.mode = Cmd::MODE_HEARTBEAT;
+      beat.sender = "test";
+      while (!stop.stop_requested()) {
+        driver_->submit(beat);
+        std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the heartbeat period
+      }
+    });
+  }
   void TearDown() override {
+    if (heartbeat_.joinable()) {
+      heartbeat_.request_stop();
+      heartbeat_.join();
+    }
     if (worker_.joinable()) {
       worker_.request_stop();
       worker_.join();
@@ -290,6 +308,7 @@ class ArmDriverTest : public testing::Test {
   std::unique_ptr<Bench> bench_;
   std::unique_ptr<ArmDriver> driver_;
   std::jthread worker_;
+  std::jthread heartbeat_;
 };
 
 const Joints kReady = C550Params{}.ready;
@@ -414,6 +433,7 @@ TEST_F(ArmDriverTest, LatestWinsUnderBurstOfCommands) {
 TEST_F(ArmDriverTest, ReconnectsAfterLinkDownAndExecutesPendingCommandOnce) {
   start();
   ASSERT_TRUE(connected());
+  keep_commanding();
   ASSERT_EQ(bench_->sessions(), 1);
   const Cmd command = move_to(1, 0.45, 0.0, 0.20);
 
@@ -444,6 +464,7 @@ TEST_F(ArmDriverTest, ReconnectsAfterLinkDownAndExecutesPendingCommandOnce) {
 TEST_F(ArmDriverTest, ResendsCommandCutOffBeforeItsCarriageReturn) {
   start();
   ASSERT_TRUE(connected());
+  keep_commanding();
   const Cmd command = move_to(1, 0.45, 0.0, 0.20);
   bench_->drop_when([](const std::string& line) { return line == "MA "; });
 
@@ -460,6 +481,7 @@ TEST_F(ArmDriverTest, ResendsCommandCutOffBeforeItsCarriageReturn) {
 TEST_F(ArmDriverTest, DoesNotResendCommandDeliveredBeforeLinkDown) {
   start();
   ASSERT_TRUE(connected());
+  keep_commanding();
   driver_->submit(move_to(1, 0.40, 0.10, 0.25));
   ASSERT_TRUE(done(1));
   const Cmd command = move_to(2, 0.45, 0.0, 0.20);
@@ -481,6 +503,7 @@ TEST_F(ArmDriverTest, DoesNotResendCommandDeliveredBeforeLinkDown) {
 TEST_F(ArmDriverTest, ResendsMoveWhenLineDropsAfterItsSpeed) {
   start();
   ASSERT_TRUE(connected());
+  keep_commanding();
   driver_->submit(move_to(1, 0.40, 0.10, 0.25));
   ASSERT_TRUE(done(1));
   Cmd command = move_to(2, 0.45, 0.0, 0.20);
@@ -505,6 +528,7 @@ TEST_F(ArmDriverTest, ResendsMoveWhenLineDropsAfterItsSpeed) {
 TEST_F(ArmDriverTest, ResendsOnlyTheGripperWhenTheLineDropsAfterTheMove) {
   start();
   ASSERT_TRUE(connected());
+  keep_commanding();
   Cmd command = move_to(1, 0.45, 0.0, 0.20);
   command.gripper = Cmd::GRIPPER_CLOSE;
   bench_->drop_when([](const std::string& line) { return line == "CL"; });

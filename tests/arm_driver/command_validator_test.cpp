@@ -258,35 +258,42 @@ TEST(CommandValidatorTest, RejectsSpeedOutsideZeroToOne) {
   }
 }
 
-// A sequence number equal to or older than the sender's last is rejected naming both numbers;
-// another sender counts on its own; a newer number from the first sender is accepted again.
+// A sequence number older than the sender's last is rejected naming both numbers; one equal to
+// it is a duplicate (no target, not a rejection); another sender counts on its own; a newer
+// number from the first sender is accepted again.
 TEST(CommandValidatorTest, RejectsSequenceNotNewerPerSender) {
   CommandValidator validator(ArmGeometry::a465());
   ASSERT_TRUE(validator.validate(cartesian(10, 0.45, 0.0, 0.20), ready_joints()).target);
 
-  EXPECT_TRUE(rejected_with(validator.validate(cartesian(10, 0.45, 0.0, 0.20), ready_joints()),
-                            "sequence 10 from 'test' is not newer than 10"));
+  const ValidationResult again = validator.validate(cartesian(10, 0.45, 0.0, 0.20), ready_joints());
+  EXPECT_FALSE(again.target);
+  EXPECT_TRUE(again.duplicate);
+  EXPECT_EQ(again.reason, "duplicate of command 10 from 'test'");
   EXPECT_TRUE(rejected_with(validator.validate(cartesian(9, 0.45, 0.0, 0.20), ready_joints()),
                             "sequence 9 from 'test' is not newer than 10"));
+  EXPECT_EQ(validator.last_sequence("test"), 10);
+  EXPECT_EQ(validator.last_sequence("nobody"), -1);
 
   Cmd other = cartesian(1, 0.45, 0.0, 0.20);
   other.sender = "sg-arm-ctl";
   EXPECT_TRUE(validator.validate(other, ready_joints()).target);
-  other.sequence = 1;
+  other.sequence = 0;
   EXPECT_TRUE(rejected_with(validator.validate(other, ready_joints()),
-                            "sequence 1 from 'sg-arm-ctl' is not newer than 1"));
+                            "sequence 0 from 'sg-arm-ctl' is not newer than 1"));
 
   EXPECT_TRUE(validator.validate(cartesian(11, 0.45, 0.0, 0.20), ready_joints()).target);
 }
 
-// A rejected command still advances its sender's sequence: resending its number is refused.
+// A rejected command still advances its sender's sequence: resending its number is a duplicate
+// (not validated again), an older one is rejected.
 TEST(CommandValidatorTest, RejectedCommandAdvancesTheSequence) {
   CommandValidator validator(ArmGeometry::a465());
   Cmd bad = cartesian(5, 0.85, 0.0, 0.30);  // out of reach
   ASSERT_FALSE(validator.validate(bad, ready_joints()).target);
 
-  EXPECT_TRUE(rejected_with(validator.validate(cartesian(5, 0.45, 0.0, 0.20), ready_joints()),
-                            "sequence 5 from 'test' is not newer than 5"));
+  EXPECT_TRUE(validator.validate(cartesian(5, 0.45, 0.0, 0.20), ready_joints()).duplicate);
+  EXPECT_TRUE(rejected_with(validator.validate(cartesian(4, 0.45, 0.0, 0.20), ready_joints()),
+                            "sequence 4 from 'test' is not newer than 5"));
 }
 
 // Modes outside MODE_CARTESIAN..MODE_STOP are rejected naming the mode.
@@ -296,8 +303,8 @@ TEST(CommandValidatorTest, RejectsUnknownMode) {
   command.mode = 0;
   EXPECT_TRUE(rejected_with(validator.validate(command, ready_joints()), "unknown mode 0"));
   command.sequence = 2;
-  command.mode = 6;
-  EXPECT_TRUE(rejected_with(validator.validate(command, ready_joints()), "unknown mode 6"));
+  command.mode = 8;
+  EXPECT_TRUE(rejected_with(validator.validate(command, ready_joints()), "unknown mode 8"));
   command.sequence = 3;
   command.mode = -1;
   EXPECT_TRUE(rejected_with(validator.validate(command, ready_joints()), "unknown mode -1"));
