@@ -9,6 +9,7 @@
 
 #include "common/grasp_names.hpp"
 #include "stereograsp/arm_cmd_t.hpp"
+#include "stereograsp/arm_status_t.hpp"
 
 namespace sg::grasp {
 
@@ -18,6 +19,7 @@ using arm::rpy_from_rotation;
 namespace {
 
 using Cmd = stereograsp::arm_cmd_t;
+using Status = stereograsp::arm_status_t;
 
 /// Microseconds in `seconds`, rounded to the nearest.
 int64_t to_us(double seconds) { return std::llround(seconds * 1e6); }
@@ -39,6 +41,27 @@ int motion_commands(int8_t mode, int8_t gripper) {
 /// Sequence numbers kept for the delay learning (an answer comes within a couple of requests).
 constexpr std::size_t kRememberedRequests = 16;
 
+/// What a rejection reason says of the commander lease: "arm commanded by '<holder>'" (at most
+/// kMaxHolder characters of the holder, printable ASCII), "" when it says nothing of it.
+constexpr std::size_t kMaxHolder = 100;
+std::string lease_holder_note(const std::string& reason) {
+  static const std::string kKey = "arm commanded by '";
+  const std::size_t at = reason.find(kKey);
+  if (at == std::string::npos) return "";
+  const std::size_t from = at + kKey.size();
+  const std::size_t end = reason.find('\'', from);
+  std::string holder = reason.substr(
+      from, std::min(end == std::string::npos ? reason.size() : end, from + kMaxHolder) - from);
+  for (char& c : holder) {
+    if (c < 0x20 || c > 0x7e || c == '\'') c = '?';
+  }
+  return "arm commanded by '" + holder + "'";
+}
+
+/// The message while the track followed is stale (GraspNode stops the heartbeats).
+const char* const kStaleTrack =
+    "no fresh track of the object: heartbeats stopped (the driver's watchdog stops the arm)";
+
 }  // namespace
 
 const char* to_string(GraspState state) { return grasp_state_name(static_cast<int>(state)); }
@@ -48,6 +71,18 @@ const char* to_string(GraspActivity activity) {
 const char* to_string(GraspAction action) { return grasp_action_name(static_cast<int>(action)); }
 const char* to_string(GraspOutcome outcome) {
   return grasp_outcome_name(static_cast<int>(outcome));
+}
+
+const char* to_string(ArmNeed need) {
+  switch (need) {
+    case ArmNeed::kNone:
+      return "none";
+    case ArmNeed::kWanted:
+      return "wanted";
+    case ArmNeed::kSilent:
+      return "silent";
+  }
+  return "unknown";
 }
 
 const char* to_string(CommandResult result) {
@@ -74,7 +109,8 @@ GraspMachine::GraspMachine(ArmGeometry geometry, GraspSettings settings, int64_t
     : geometry_(std::move(geometry)),
       settings_(std::move(settings)),
       next_sequence_(first_sequence),
-      delay_(settings_.default_delay) {}
+      delay_(settings_.default_delay),
+      first_sequence_(first_sequence) {}
 
 // ---------------------------------------------------------------------------------------------
 // Inputs.
@@ -139,6 +175,7 @@ CommandReply GraspMachine::grasp(const std::string& where, int64_t now) {
   status_.last_action = GraspAction::kApproachObject;
   status_.outcome = GraspOutcome::kNone;
   if (next_ == NextAction::kHome) next_ = NextAction::kNone;
+  if (arm_.gripper != Status::GRIPPER_OPEN) plan(NextAction::kOpen);  // a0, then the approach
   set_message("");
   return {CommandResult::kAccepted, ""};
 }
@@ -162,6 +199,7 @@ CommandReply GraspMachine::abort(const std::string& where) {
   status_.activity = GraspActivity::kIdle;
   judging_ = false;
   next_ = NextAction::kStop;  // the STOP opens the hand: no a0, lift, back-off or home after it
+  retry_utime_ = 0;           // an operator's abort waits for no back-off
   return {CommandResult::kAccepted, ""};
 }
 
@@ -198,8 +236,13 @@ void GraspMachine::on_measurement(const std::optional<Eigen::Vector3d>& position
 }
 
 void GraspMachine::on_arm_status(const ArmView& arm, int64_t now) {
+  const bool restarted = have_arm_ && arm.driver_start_utime != arm_.driver_start_utime;
+  if (!have_arm_) start_from(arm);
   arm_ = arm;
   have_arm_ = true;
+  arm_utime_ = now;
+  // The old driver may have executed the request in flight: never resend it, compute afresh.
+  if (restarted && in_flight_) answered(true, "driver restarted: abandoned ", now);
 
   // The delay: the driver publishes a new interaction_time once the interaction of its
   // last_executed_sequence is complete.
@@ -218,8 +261,12 @@ void GraspMachine::on_arm_status(const ArmView& arm, int64_t now) {
   if (in_flight_) {
     const int64_t sequence = in_flight_->sequence;
     if (arm.last_rejected_sequence == sequence) {
-      answered(true, "rejected", now);
+      rejected(now);
     } else if (arm.last_executed_sequence == sequence) {
+      rejections_ = 0;
+      retry_utime_ = 0;
+      if (waiting_for_lease_) set_message("");  // the lease is ours again
+      waiting_for_lease_ = false;
       answered(false, "", now);
     }
   }
@@ -231,10 +278,20 @@ void GraspMachine::on_arm_status(const ArmView& arm, int64_t now) {
 // Requests.
 
 std::optional<ArmRequest> GraspMachine::take_request(int64_t now) {
+  std::optional<ArmRequest> r = choose_request(now);
+  // Kept whole (cartesian() and aim() fill it in after make()), for a resend.
+  if (r && in_flight_ && in_flight_->sequence == r->sequence) in_flight_->request = *r;
+  return r;
+}
+
+std::optional<ArmRequest> GraspMachine::choose_request(int64_t now) {
   update(now);
   if (!have_arm_ || !arm_.connected) return std::nullopt;
-  if (next_ == NextAction::kStop) return send_stop(now);  // at once, even with one in flight
-  if (in_flight_) return std::nullopt;
+  // At once, even with one in flight or ARM_STATUS silent: a STOP is safe, obeyed from anyone.
+  if (next_ == NextAction::kStop && now >= retry_utime_) return send_stop(now);
+  if (arm_status_silence(now)) return std::nullopt;
+  if (in_flight_) return resend(now);
+  if (now < retry_utime_) return std::nullopt;
   switch (next_) {
     case NextAction::kOpen:
       return send_open(now);
@@ -256,6 +313,41 @@ std::optional<ArmRequest> GraspMachine::take_request(int64_t now) {
     return aim(Kind::kTrack, now);
   }
   return std::nullopt;
+}
+
+std::optional<ArmRequest> GraspMachine::resend(int64_t now) {
+  if (arm_has(in_flight_->sequence)) return std::nullopt;
+  if (now - in_flight_->resent_utime < to_us(settings_.resend_after)) return std::nullopt;
+  in_flight_->resent_utime = now;
+  ++resends_;
+  return in_flight_->request;
+}
+
+bool GraspMachine::arm_has(int64_t sequence) const {
+  return arm_.last_received_sequence == sequence || arm_.last_executed_sequence == sequence ||
+         arm_.last_rejected_sequence == sequence;
+}
+
+ArmNeed GraspMachine::arm_need(int64_t now) const {
+  if (!have_arm_) return ArmNeed::kNone;
+  if (arm_status_silence(now)) return ArmNeed::kSilent;
+  const GraspActivity activity = status_.activity;
+  if (activity == GraspActivity::kTracking && status_.state == GraspState::kHandOpened) {
+    return track_fresh(now) ? ArmNeed::kWanted : ArmNeed::kSilent;
+  }
+  const bool own_motion = arm_.moving && arm_.last_executed_sequence >= first_sequence_ &&
+                          arm_.last_executed_sequence < next_sequence_;
+  if (in_flight_ || next_ != NextAction::kNone || activity != GraspActivity::kIdle || own_motion) {
+    return ArmNeed::kWanted;
+  }
+  return ArmNeed::kNone;
+}
+
+std::optional<double> GraspMachine::arm_status_silence(int64_t now) const {
+  if (!have_arm_) return std::nullopt;
+  const double silence = static_cast<double>(now - arm_utime_) * 1e-6;
+  if (silence <= settings_.arm_status_timeout) return std::nullopt;
+  return silence;
 }
 
 void GraspMachine::plan(NextAction action) {
@@ -349,7 +441,7 @@ std::optional<ArmRequest> GraspMachine::aim(Kind kind, int64_t now) {
   int64_t source_utime = 0;
   const std::optional<PredictedPath> path = fresh_path(now, &source_utime);
   if (!path) {
-    refuse("no fresh track of the object");
+    refuse(kind == Kind::kTrack ? kStaleTrack : "no fresh track of the object");
     return std::nullopt;
   }
   bool approach = kind == Kind::kApproach;
@@ -407,23 +499,46 @@ ArmRequest GraspMachine::make(Kind kind, int8_t mode, int8_t gripper, int64_t no
   r.mode = mode;
   r.gripper = gripper;
   r.speed = settings_.speed;
-  in_flight_ = InFlight{r.sequence, kind, now};
+  in_flight_ = InFlight{r.sequence, kind, now, now, r};
   motion_commands_[r.sequence] = motion_commands(mode, gripper);
   while (motion_commands_.size() > kRememberedRequests) {
     motion_commands_.erase(motion_commands_.begin());
   }
-  if (message_is_refusal_) set_message("");
+  if (message_is_refusal_ && !waiting_for_lease_) set_message("");
   return r;
 }
 
 // ---------------------------------------------------------------------------------------------
 // Answers, time and the track.
 
-void GraspMachine::answered(bool failed, const std::string& how, int64_t now) {
+void GraspMachine::start_from(const ArmView& arm) {
+  // An abort before the first status: the STOP opens the hand, q0 stands.
+  if (arm.gripper != Status::GRIPPER_CLOSED || next_ == NextAction::kStop) return;
+  status_.state = GraspState::kHandClosed;
+  if (next_ == NextAction::kOpen) next_ = NextAction::kNone;  // a0 only when asked
+  const GraspActivity activity = status_.activity;
+  if (activity == GraspActivity::kTracking || activity == GraspActivity::kGrasping) {
+    status_.activity = GraspActivity::kIdle;
+    refuse(std::string("the gripper is reported closed: q3 hand closed, ") +
+           (activity == GraspActivity::kTracking ? "track" : "grasp") +
+           " cancelled (release first)");
+  }
+}
+
+void GraspMachine::rejected(int64_t now) {
+  ++rejections_;
+  const double wait = kRetryFirst * std::ldexp(1.0, std::min(rejections_, 30) - 1);
+  retry_utime_ = now + to_us(std::min(wait, kRetryLongest));
+  const std::string lease = lease_holder_note(arm_.rejection_reason);
+  waiting_for_lease_ = !lease.empty();
+  answered(true, "the arm rejected ", now);
+  if (waiting_for_lease_) refuse("waiting: " + lease + "; " + status_.message);
+}
+
+void GraspMachine::answered(bool failed, const std::string& failure, int64_t now) {
   const InFlight done = *in_flight_;
   in_flight_.reset();
   const std::string request = " (request " + std::to_string(done.sequence) + ")";
-  const std::string failure = "the arm " + how + " ";
   switch (done.kind) {
     case Kind::kOpenHand:
       if (failed) {
@@ -507,8 +622,9 @@ void GraspMachine::backoff_answered(bool failed, const std::string& failure,
 void GraspMachine::update(int64_t now) {
   if (in_flight_) {
     const double limit = std::max(kAnswerTimeout, 8 * delay_);
-    if (now - in_flight_->sent_utime > to_us(limit)) answered(true, "did not answer", now);
+    if (now - in_flight_->sent_utime > to_us(limit)) answered(true, "the arm did not answer ", now);
   }
+  note_stale_track(now);
   if (status_.state == GraspState::kApproaching && status_.activity == GraspActivity::kGrasping &&
       !track_fresh(now)) {
     status_.state = GraspState::kHandOpened;
@@ -518,6 +634,17 @@ void GraspMachine::update(int64_t now) {
     plan(NextAction::kBackoff);
   }
   judge(now);
+}
+
+void GraspMachine::note_stale_track(int64_t now) {
+  const bool tracking =
+      status_.activity == GraspActivity::kTracking && status_.state == GraspState::kHandOpened;
+  const bool stale = tracking && !track_fresh(now);
+  if (stale && status_.message != kStaleTrack && !waiting_for_lease_) {
+    refuse(kStaleTrack);
+  } else if (!stale && status_.message == kStaleTrack) {
+    set_message("");
+  }
 }
 
 void GraspMachine::judge(int64_t now) {

@@ -7,16 +7,51 @@
 ///
 /// The machine is pure: no clock and no bus. A shell (sg-grasp) turns GRASP_COMMAND,
 /// OBJECT_TRAJECTORY, OBJECT_POSITION and ARM_STATUS into the on_*() calls, asks take_request()
-/// for the next ARM_COMMAND after each of them, and publishes status() on GRASP_STATUS. Times are
+/// for the next ARM_COMMAND after each of them, asks arm_need() whether to keep the commander
+/// lease (heartbeats, GraspNode), and publishes status() on GRASP_STATUS. Times are
 /// microseconds since the Unix epoch, lengths metres, in the robot base frame.
+///
+/// A start does nothing unasked. The machine sends nothing until an operator's command asks for
+/// it. Its starting state comes from the first ARM_STATUS: the gripper reported CLOSED gives
+/// q3 hand closed, idle (the arm may hold the ball: release opens it); anything else q0 idle.
+/// (A command taken before that first status that the closed hand forbids, track or grasp, is
+/// cancelled then, with a message.) A grasp asked for in q0 while the gripper is not reported
+/// OPEN plans a0 first, and the approach follows it.
 ///
 /// One request in flight. The C550 answers one interaction every 0.72-0.84 s and the driver
 /// keeps only the latest command, so the machine sends a new request only after ARM_STATUS
 /// reported the previous one executed (last_executed_sequence) or rejected
 /// (last_rejected_sequence): each target is computed just before the controller can act on it,
 /// from the newest prediction. The one exception is abort, which is sent at once (the driver's
-/// latest-wins slot makes the STOP the next thing on the line). A request with no answer for
-/// kAnswerTimeout (or 8 delays, whichever is longer) is given up and treated as rejected.
+/// latest-wins slot makes the STOP the next thing on the line).
+///
+/// A lost request is resent, a driver restart is not. A request in flight that ARM_STATUS does
+/// not show received (last_received_sequence, last_executed_sequence and last_rejected_sequence
+/// all differ from its sequence) resend_after (0.5 s) after it was sent or last resent is sent
+/// again: the same sequence and content (the driver executes a sequence once; the shell signs
+/// the copy anew), counted in resends(). When ARM_STATUS's driver_start_utime changes with a
+/// request in flight (the driver restarted; the old one may have executed it), the request is
+/// not resent: it is abandoned as failed ("driver restarted") and the next one is computed afresh
+/// under a new sequence. A request with no answer for kAnswerTimeout (or 8 delays, whichever is
+/// longer) since it was first sent is given up and treated as failed.
+///
+/// Rejections are backed off. After the k-th consecutive rejection (reset when a request is
+/// executed) the next request waits min(kRetryFirst * 2^(k-1), kRetryLongest): 0.25, 0.5, 1, 2,
+/// 4, 4 s ... (an operator's abort waits for nothing). A rejection whose reason says another
+/// sender holds the commander lease ("arm commanded by 'sg-arm-ctl@bench:77'") shows as
+/// "waiting: arm commanded by 'sg-arm-ctl@bench:77'" until a request is executed.
+///
+/// A silent ARM_STATUS stops the requests. No ARM_STATUS for more than arm_status_timeout
+/// (1.0 s; the driver publishes at 10 Hz) makes no request (but an abort's STOP, which is safe
+/// and obeyed from anyone) and no heartbeat (arm_need() kSilent) until statuses return;
+/// arm_status_silence() says for how long (GraspNode shows "ARM_STATUS silent for 1.3 s").
+///
+/// The commander lease (arm_need(), see ArmNeed). The machine wants the arm while a request is
+/// in flight, a one-off request is planned, it tracks with a fresh track, grasps, homes, backs
+/// off, or the arm still moves from one of its own commands; the shell then sends heartbeats,
+/// and one MODE_RELEASE when it stops wanting it. While tracking, a track gone stale is kSilent:
+/// no heartbeat, so the driver's watchdog stops the arm (status().message says so), until the
+/// track returns.
 ///
 /// Interception. A Cartesian target aims where the ball will be when the gripper gets there:
 /// intercept() (interception.hpp) with lead = delay_estimate(). Tracking uses the offset
@@ -43,9 +78,11 @@
 /// | q4 grasping (judging) | refused     | refused     | q0 idle OPEN! | q0 idle STOP! | refused  |
 /// | q4 idle               | refused     | refused     | q0 idle OPEN  | q0 idle STOP  | homing H |
 ///
-/// grasp*: with a fresh track, otherwise refused. STOP: MODE_STOP + GRIPPER_OPEN; OPEN (a0):
-/// MODE_GRIPPER_ONLY + GRIPPER_OPEN, the state turns q0 when it is sent; H: MODE_HOME +
-/// GRIPPER_KEEP, the state unchanged. "!": the grasp in progress ends with outcome kAborted. A
+/// At the start: q0 idle, or q3 idle when the first ARM_STATUS reports the gripper CLOSED; no
+/// request until a command. grasp*: with a fresh track, otherwise refused; the request is a1,
+/// or OPEN (a0) first when the gripper is not reported OPEN. STOP: MODE_STOP + GRIPPER_OPEN;
+/// OPEN (a0): MODE_GRIPPER_ONLY + GRIPPER_OPEN, the state turns q0 when it is sent; H: MODE_HOME
+/// + GRIPPER_KEEP, the state unchanged. "!": the grasp in progress ends with outcome kAborted. A
 /// fresh track is a trajectory that is not lost and not older than max_trajectory_age. Homing ends
 /// (activity idle) when HOME is executed.
 ///
@@ -68,23 +105,22 @@
 ///    straight up by `backoff` from the current tool (orientation by forward kinematics of the
 ///    current joints); idle when it is executed. In q2 and later the close is already on its way
 ///    and the track is no longer needed. While tracking, a lost track only stops the requests
-///    until it returns.
+///    (and the heartbeats) until it returns.
 ///  - A lift or back-off rejected by the arm ends the sequence (q3/idle failed, or q0/idle): the
 ///    same target would be rejected again. A rejected tracking move, approach, open or stop is
-///    computed afresh and sent again.
+///    computed afresh and sent again (after the back-off).
 ///
-/// The first request, once the arm is connected, is a0 (open hand). Requests are made only
-/// while ArmView.connected.
+/// Requests are made only while ArmView.connected.
 ///
 /// The next one-off request is one value, NextAction, besides the requests that follow the ball
 /// (tracking, the approach), which are computed from the state and activity. Its precedence, in
 /// take_request() and when a second one is asked for before the first is sent: kStop (abort; sent
-/// even with a request in flight) over kOpen (a0: start, release, a retry) over the one the
-/// activity calls for (kBackoff while backing off, kLift in q3 grasping, kHome while homing;
-/// these three exclude each other). A higher one asked for hides a lower one; the lower one is
-/// taken up again from the activity once the higher is sent (abort, then home: STOP, then HOME;
-/// release, then home: OPEN, then HOME). a0 sent in q1 (a grasp asked for before the first a0
-/// went out) leaves q1: the approach follows it.
+/// even with a request in flight) over kOpen (a0: release, a grasp with the hand not reported
+/// open, a retry) over the one the activity calls for (kBackoff while backing off, kLift in q3
+/// grasping, kHome while homing; these three exclude each other). A higher one asked for hides a
+/// lower one; the lower one is taken up again from the activity once the higher is sent (abort,
+/// then home: STOP, then HOME; release, then home: OPEN, then HOME). a0 sent in q1 (a grasp
+/// asked for with the hand not reported open) leaves q1: the approach follows it.
 ///
 /// Every command is answered (on_command()'s CommandReply): accepted, or refused by the state
 /// with the reason (the same text as status().message).
@@ -100,6 +136,7 @@
 ///     machine.on_trajectory(path_from(trajectory), trajectory.source_utime, now);
 ///     CommandReply reply = machine.on_command(GraspCommand::kGrasp, 0.0, now);
 ///     if (std::optional<ArmRequest> r = machine.take_request(now)) publish(to_arm_cmd(*r));
+///     if (machine.arm_need(now) == ArmNeed::kWanted) ... heartbeat every heartbeat_period
 ///     publish(to_grasp_status(machine.status()));
 
 #include <Eigen/Core>
@@ -166,9 +203,9 @@ enum class CommandResult : int8_t {
   kNone = 0,             ///< no command yet
   kAccepted = 1,         ///< taken up (a command that changes nothing, e.g. home while homing)
   kRefusedNotNewer = 2,  ///< its sequence is not newer than its sender's last
-  kRefusedUnknownCommand = 3,  ///< not a COMMAND_* value
-  kRefusedBadArgument = 4,     ///< e.g. a stand-off outside 0..0.5 m
-  kRefusedState = 5,           ///< not in this state (a grasp without a fresh track, ...)
+  kRefusedUnknownCommand = 3,   ///< not a COMMAND_* value
+  kRefusedBadArgument = 4,      ///< e.g. a stand-off outside 0..0.5 m
+  kRefusedState = 5,            ///< not in this state (a grasp without a fresh track, ...)
   kRefusedUnauthenticated = 6,  ///< unsigned, a wrong tag, replayed or stale (docs/security.md)
 };
 
@@ -191,8 +228,12 @@ struct ArmView {
   bool connected = false;  ///< state != DISCONNECTED
   bool moving = false;     ///< state == MOVING
   bool error = false;      ///< state == ERROR (informational: refusals come as rejections)
+  int8_t gripper = 0;      ///< arm_status_t::GRIPPER_UNKNOWN / GRIPPER_OPEN / GRIPPER_CLOSED
+  int64_t last_received_sequence = -1;
   int64_t last_executed_sequence = -1;
   int64_t last_rejected_sequence = -1;
+  std::string rejection_reason;    ///< why last_rejected_sequence was rejected
+  int64_t driver_start_utime = 0;  ///< changes when the driver restarts
   Joints joints = Joints::Zero();
   Eigen::Vector3d tool = Eigen::Vector3d::Zero();  ///< tool centre point
   double interaction_time = 0;                     ///< s, of the driver's last interaction
@@ -228,9 +269,23 @@ struct GraspSettings {
   double judge_time = 3.0;      ///< s after the arm stops: no sighting that close by then = failed
   double default_delay = 0.78;  ///< s per controller command until one is measured
   bool use_prediction = true;   ///< false: aim at the last measurement (PredictedPath::hold)
+  double heartbeat_period = 0.2;    ///< s between MODE_HEARTBEAT while the arm is wanted
+  double resend_after = 0.5;        ///< s: a request ARM_STATUS does not show received is resent
+  double arm_status_timeout = 1.0;  ///< s without ARM_STATUS: no request, no heartbeat
   InterceptionSettings interception;
   InputGate input_gate;
 };
+
+/// What the machine asks of the commander lease (arm_cmd_t MODE_HEARTBEAT / MODE_RELEASE).
+enum class ArmNeed : int8_t {
+  kNone,    ///< not wanted: release the lease (once)
+  kWanted,  ///< keep it: a heartbeat every heartbeat_period
+  kSilent,  ///< wanted, but no heartbeat (ARM_STATUS silent, or the track followed gone stale):
+            ///< the driver's watchdog stops the arm
+};
+
+/// "none", "wanted", "silent".
+const char* to_string(ArmNeed need);
 
 /// What GRASP_STATUS shows.
 struct GraspStatusView {
@@ -251,6 +306,10 @@ class GraspMachine {
   static constexpr double kAnswerTimeout = 5.0;  // s
   /// After the lift, the outcome is judged even if the arm still reports moving after this.
   static constexpr double kSettleTimeout = 3.0;  // s
+  /// The wait before the retry after the first rejection, doubled for each further one ...
+  static constexpr double kRetryFirst = 0.25;  // s
+  /// ... up to this.
+  static constexpr double kRetryLongest = 4.0;  // s
 
   /// `first_sequence`: the sequence number of the first request (then +1 per request).
   GraspMachine(ArmGeometry geometry, GraspSettings settings, int64_t first_sequence);
@@ -273,8 +332,26 @@ class GraspMachine {
   /// The next command for the arm, or nullopt. At most one request in flight: a new one only
   /// after the arm reported the previous one executed (or rejected), so each is computed just
   /// before the controller can act on it. Abort is the exception (sent at once). Sequence
-  /// numbers increase from first_sequence.
+  /// numbers increase from first_sequence. A resend returns the request in flight again (the
+  /// same sequence and content). Nothing before the first ARM_STATUS, while ARM_STATUS is
+  /// silent (but a STOP) or during a back-off after a rejection.
   std::optional<ArmRequest> take_request(int64_t now);
+
+  /// Whether the machine wants the arm at `now` (see ArmNeed and the file comment).
+  ArmNeed arm_need(int64_t now) const;
+
+  /// Seconds since the last ARM_STATUS when that is more than arm_status_timeout, else nullopt
+  /// (also before the first one).
+  std::optional<double> arm_status_silence(int64_t now) const;
+
+  /// The sequence of the last request made (first_sequence - 1 before any).
+  int64_t last_sequence() const { return next_sequence_ - 1; }
+  /// Requests sent again under the same sequence so far.
+  uint64_t resends() const { return resends_; }
+  /// Rejections since the last request the arm executed.
+  int consecutive_rejections() const { return rejections_; }
+  /// No request but a STOP before this time (the back-off after a rejection; 0: none).
+  int64_t retry_utime() const { return retry_utime_; }
 
   const GraspStatusView& status() const { return status_; }
 
@@ -296,7 +373,9 @@ class GraspMachine {
   struct InFlight {
     int64_t sequence = 0;
     Kind kind = Kind::kTrack;
-    int64_t sent_utime = 0;
+    int64_t sent_utime = 0;    ///< first sent (the answer time-out counts from here)
+    int64_t resent_utime = 0;  ///< last sent or resent
+    ArmRequest request;        ///< what was sent, for a resend
   };
 
   /// Commands, one function each; each returns its reply. `where`: " in <state> (<activity>)".
@@ -327,8 +406,21 @@ class GraspMachine {
   /// Starts the back-off when the track is lost during q1; outcome judging and time-outs.
   void update(int64_t now);
   void judge(int64_t now);
-  /// The request in flight was executed, or `failed` (`how`: "rejected", "did not answer").
-  void answered(bool failed, const std::string& how, int64_t now);
+  /// take_request() but for keeping what it returns whole in in_flight_.
+  std::optional<ArmRequest> choose_request(int64_t now);
+  /// The request in flight again when ARM_STATUS does not show it received after resend_after.
+  std::optional<ArmRequest> resend(int64_t now);
+  /// The first ARM_STATUS: q3 when the gripper is reported closed.
+  void start_from(const ArmView& arm);
+  /// Whether ARM_STATUS shows `sequence` received, executed or rejected.
+  bool arm_has(int64_t sequence) const;
+  /// A rejection of the request in flight: the back-off and, for a lease, the waiting message.
+  void rejected(int64_t now);
+  /// While tracking: the message that the track went stale (heartbeats stopped), or its end.
+  void note_stale_track(int64_t now);
+  /// The request in flight was executed, or failed; `failure` starts the message ("the arm
+  /// rejected ", "the arm did not answer ", "driver restarted: abandoned ").
+  void answered(bool failed, const std::string& failure, int64_t now);
   /// answered() for each kind whose answer moves the state or the activity; `failure` + what +
   /// `request` is the message when the arm failed it.
   void home_answered(bool failed, const std::string& failure, const std::string& request);
@@ -354,8 +446,10 @@ class GraspMachine {
   int64_t next_sequence_;
   double delay_;
 
+  int64_t first_sequence_;
   ArmView arm_;
   bool have_arm_ = false;
+  int64_t arm_utime_ = 0;  ///< when the last ARM_STATUS arrived
   std::optional<PredictedPath> path_;
   int64_t path_source_utime_ = 0;
   std::optional<Eigen::Vector3d> measured_;  ///< last visible measurement
@@ -365,8 +459,13 @@ class GraspMachine {
   std::map<int64_t, int> motion_commands_;  ///< sequence -> motion commands, for the delay
   double seen_interaction_time_ = 0;
 
-  NextAction next_ = NextAction::kOpen;  ///< a0 first
+  NextAction next_ = NextAction::kNone;  ///< nothing until a command asks
   bool message_is_refusal_ = false;
+
+  uint64_t resends_ = 0;
+  int rejections_ = 0;              ///< consecutive, reset by an executed request
+  int64_t retry_utime_ = 0;         ///< the back-off: no request but a STOP before this
+  bool waiting_for_lease_ = false;  ///< the last rejection said another sender commands the arm
 
   Eigen::Vector3d approach_position_ = Eigen::Vector3d::Zero();  ///< a1's target, for the lift
   Eigen::Vector3d approach_rpy_ = Eigen::Vector3d::Zero();

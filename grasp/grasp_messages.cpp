@@ -25,8 +25,12 @@ ArmView arm_view_of(const stereograsp::arm_status_t& s) {
   v.connected = s.state != S::STATE_DISCONNECTED;
   v.moving = s.state == S::STATE_MOVING;
   v.error = s.state == S::STATE_ERROR;
+  v.gripper = s.gripper;
+  v.last_received_sequence = s.last_received_sequence;
   v.last_executed_sequence = s.last_executed_sequence;
   v.last_rejected_sequence = s.last_rejected_sequence;
+  v.rejection_reason = s.rejection_reason;
+  v.driver_start_utime = s.driver_start_utime;
   for (int i = 0; i < 6; ++i) v.joints[i] = s.joints[i];
   v.tool = {s.tool_position[0], s.tool_position[1], s.tool_position[2]};
   v.interaction_time = s.interaction_time;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <utility>
 
 namespace sg::grasp {
@@ -22,6 +23,8 @@ GraspNode::GraspNode(ArmGeometry geometry, GraspSettings settings, int64_t first
                      double status_period)
     : workspace_(geometry.workspace),
       gate_(settings.input_gate),
+      heartbeat_period_(settings.heartbeat_period),
+      speed_(settings.speed),
       machine_(std::move(geometry), std::move(settings), first_sequence),
       status_rule_(status_period) {}
 
@@ -123,29 +126,80 @@ const CommandRecord& GraspNode::answer(int64_t sequence, CommandResult result, s
 GraspNode::Output GraspNode::poll(int64_t now) {
   Output out;
   if (std::optional<ArmRequest> request = machine_.take_request(now)) {
-    out.arm_command = to_arm_cmd(*request, trajectory_utime_ ? trajectory_utime_ : now);
+    if (!sent_ || sent_->sequence != request->sequence) {  // new; else a resend, the same message
+      sent_ = to_arm_cmd(*request, trajectory_utime_ ? trajectory_utime_ : now);
+    }
+    out.arm_command = sent_;
   }
+  out.lease = lease_command(now);
   // The refusal note changes at most once per kRefusalNotePeriod (or when the clock went back).
-  if (refusals_changed_ && (now - note_utime_ >= static_cast<int64_t>(kRefusalNotePeriod * 1e6) ||
-                            now < note_utime_)) {
+  if (refusals_changed_ &&
+      (now - note_utime_ >= static_cast<int64_t>(kRefusalNotePeriod * 1e6) || now < note_utime_)) {
     note_ = refusal_note();
     note_utime_ = now;
     refusals_changed_ = false;
   }
-  const std::string s =
-      summary(machine_.status()) + (note_.empty() ? "" : " [" + note_ + "]");
+  std::string s = summary(machine_.status());
+  for (const std::string& note : notes(now, false)) s += " [" + note + "]";
   const bool changed = s != last_summary_;
   if (changed || command_changed_) ++status_version_;
   if (status_rule_.due(status_version_, static_cast<double>(now) * 1e-6)) {
     out.status = to_grasp_status(machine_.status(), now, command_);
-    if (!note_.empty()) {
-      std::string& message = out.status->message;
-      message += (message.empty() ? "" : "; ") + note_;
-    }
+    std::string& message = out.status->message;
+    for (const std::string& note : notes(now, true))
+      message += (message.empty() ? "" : "; ") + note;
     if (changed) out.changed_summary = s;
     last_summary_ = s;
     command_changed_ = false;
   }
+  return out;
+}
+
+std::optional<stereograsp::arm_cmd_t> GraspNode::lease_command(int64_t now) {
+  if (!sent_) return std::nullopt;  // no request yet: nothing to keep
+  using Cmd = stereograsp::arm_cmd_t;
+  int8_t mode = 0;
+  switch (machine_.arm_need(now)) {
+    case ArmNeed::kWanted: {
+      const int64_t since = now - heartbeat_utime_;
+      if (holding_ && since >= 0 && since < std::llround(heartbeat_period_ * 1e6)) {
+        return std::nullopt;
+      }
+      holding_ = true;
+      heartbeat_utime_ = now;
+      ++heartbeats_;
+      mode = Cmd::MODE_HEARTBEAT;
+      break;
+    }
+    case ArmNeed::kSilent:  // the driver's watchdog stops the arm
+      return std::nullopt;
+    case ArmNeed::kNone:
+      if (!holding_) return std::nullopt;
+      holding_ = false;
+      ++releases_;
+      mode = Cmd::MODE_RELEASE;
+      break;
+  }
+  Cmd c{};
+  c.utime = now;
+  c.sequence = sent_->sequence;  // the last request's: a heartbeat consumes no sequence
+  c.mode = mode;
+  c.gripper = Cmd::GRIPPER_KEEP;
+  c.speed = speed_;
+  c.sender = sent_->sender;
+  return c;
+}
+
+std::vector<std::string> GraspNode::notes(int64_t now, bool exact) const {
+  std::vector<std::string> out;
+  if (const std::optional<double> silence = machine_.arm_status_silence(now)) {
+    char text[64];
+    std::snprintf(text, sizeof text, "ARM_STATUS silent for %.1f s", *silence);
+    out.emplace_back(exact ? text : "ARM_STATUS silent");
+  }
+  if (machine_.resends() > 0)
+    out.push_back("ARM_COMMAND resent " + std::to_string(machine_.resends()));
+  if (!note_.empty()) out.push_back(note_);
   return out;
 }
 

@@ -21,17 +21,30 @@
 ///     settings.input_gate.margin, a bad period, too many points, times far from `now`. The
 ///     counts and the newest reason ride on GRASP_STATUS's message, updated at most once per
 ///     kRefusalNotePeriod so a flood of bad trajectories cannot flood GRASP_STATUS.
-///   - ARM_COMMAND: at most one per poll(), the machine's take_request(now); its utime is the
-///     newest trajectory's utime (the decision's message time), `now` before any trajectory.
-///   - GRASP_STATUS: when the summary (state, activity, last action, outcome, message) or the
-///     command answer changed, and otherwise once per status period (also when `now` went back
-///     in time, so a clock step cannot silence it).
+///   - ARM_COMMAND, two kinds, each at most one per poll():
+///     `arm_command`, the machine's take_request(now): a new request (its utime is the newest
+///     trajectory's utime, the decision's message time; `now` before any trajectory), or a
+///     resend of the request in flight, the very message sent first (same sequence, utime and
+///     content; the shell signs it anew);
+///     `lease`, the commander lease (machine().arm_need(now)): while kWanted a MODE_HEARTBEAT
+///     (sequence: the last request's, gripper KEEP, the machine's speed, utime `now`) once every
+///     settings.heartbeat_period from the first poll that wants the arm; when it turns kNone one
+///     MODE_RELEASE; while kSilent (ARM_STATUS silent, or the track followed gone stale) nothing,
+///     so the driver's watchdog stops the arm. None before the first request. Publish
+///     `arm_command` first, then `lease`.
+///   - GRASP_STATUS: when the summary (state, activity, last action, outcome, message, notes)
+///     or the command answer changed, and otherwise once per status period (also when `now` went
+///     back in time, so a clock step cannot silence it). Its message is the machine's, then the
+///     notes, "; "-separated: "ARM_STATUS silent for 1.3 s" (the summary says only "ARM_STATUS
+///     silent", so the count does not make every poll a change), "ARM_COMMAND resent 2" (the
+///     machine's resends()), the refusal note.
 ///
 ///     GraspNode node(geometry, settings, /*first_sequence=*/now, /*status_period=*/0.25);
 ///     node.require_signed_commands(key);                // the lab key (auth/lab_key.hpp)
 ///     node.on_command(command, now);                    // from each subscription
 ///     GraspNode::Output out = node.poll(now);           // from the loop, every 10 ms
-///     if (out.arm_command) bus.publish("ARM_COMMAND", *out.arm_command);
+///     if (out.arm_command) bus.publish("ARM_COMMAND", signed(*out.arm_command));
+///     if (out.lease) bus.publish("ARM_COMMAND", signed(*out.lease));
 ///     if (out.status) bus.publish("GRASP_STATUS", *out.status);
 
 #include <array>
@@ -39,6 +52,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "auth/command_auth.hpp"
 #include "common/change_or_period.hpp"
@@ -64,9 +78,10 @@ class GraspNode {
   /// Seconds between updates of the refusal note on GRASP_STATUS's message.
   static constexpr double kRefusalNotePeriod = 1.0;
 
-  /// What to publish now.
+  /// What to publish now (ARM_COMMAND unsigned: the shell signs each).
   struct Output {
-    std::optional<stereograsp::arm_cmd_t> arm_command;  ///< ARM_COMMAND
+    std::optional<stereograsp::arm_cmd_t> arm_command;  ///< ARM_COMMAND: a request, or a resend
+    std::optional<stereograsp::arm_cmd_t> lease;  ///< ARM_COMMAND MODE_HEARTBEAT / MODE_RELEASE
     std::optional<stereograsp::grasp_status_t> status;  ///< GRASP_STATUS
     std::string changed_summary;  ///< the new summary when it changed (for the log), else ""
   };
@@ -106,9 +121,13 @@ class GraspNode {
   /// Returns the answer that the next GRASP_STATUS carries.
   const CommandRecord& on_command(const stereograsp::grasp_command_t& command, int64_t now);
 
-  /// What to publish at `now`: at most one ARM_COMMAND, and GRASP_STATUS on a change or when
-  /// the status period has passed.
+  /// What to publish at `now`: at most one request (or resend) and one heartbeat or release,
+  /// and GRASP_STATUS on a change or when the status period has passed.
   Output poll(int64_t now);
+
+  /// MODE_HEARTBEAT and MODE_RELEASE sent so far.
+  uint64_t heartbeats() const { return heartbeats_; }
+  uint64_t releases() const { return releases_; }
 
   const GraspMachine& machine() const { return machine_; }
   /// The answer to the last command (sequence -1 before any).
@@ -127,12 +146,19 @@ class GraspNode {
   const CommandRecord& answer(int64_t sequence, CommandResult result, std::string reason);
   /// Checks `command`'s sequence against its sender's last; true when newer (or first).
   bool newer(const stereograsp::grasp_command_t& command, int64_t now, std::string* why);
+  /// The heartbeat or release due at `now`, if any.
+  std::optional<stereograsp::arm_cmd_t> lease_command(int64_t now);
+  /// The notes GRASP_STATUS's message carries after the machine's; `exact`: with the numbers
+  /// that change by themselves (the silence), else without (for the summary).
+  std::vector<std::string> notes(int64_t now, bool exact) const;
 
   arm::Workspace workspace_;  ///< the arm's, for the trajectory gate (before machine_ takes it)
   InputGate gate_;
+  double heartbeat_period_;  ///< s
+  double speed_;             ///< the heartbeats' speed (the machine's)
   GraspMachine machine_;
-  ChangeOrPeriod status_rule_;  ///< GRASP_STATUS on a change, else once a period
-  uint64_t status_version_ = 0;  ///< counts the changes of the summary and the command answer
+  ChangeOrPeriod status_rule_;    ///< GRASP_STATUS on a change, else once a period
+  uint64_t status_version_ = 0;   ///< counts the changes of the summary and the command answer
   int64_t trajectory_utime_ = 0;  ///< the newest OBJECT_TRAJECTORY's utime (0: none yet)
   std::map<std::string, Sender> senders_;
   std::optional<auth::CommandVerifier> verifier_;  ///< set by require_signed_commands()
@@ -143,8 +169,13 @@ class GraspNode {
   std::array<uint64_t, kTrajectoryRefusals> refused_{};
   std::string last_refusal_;
   bool refusals_changed_ = false;
-  std::string note_;            ///< refusal_note() as last put on GRASP_STATUS
-  int64_t note_utime_ = 0;      ///< when note_ was updated
+  std::string note_;                            ///< refusal_note() as last put on GRASP_STATUS
+  int64_t note_utime_ = 0;                      ///< when note_ was updated
+  std::optional<stereograsp::arm_cmd_t> sent_;  ///< the last request as first sent
+  bool holding_ = false;                        ///< a heartbeat went out since the last release
+  int64_t heartbeat_utime_ = 0;                 ///< when the last heartbeat went out
+  uint64_t heartbeats_ = 0;
+  uint64_t releases_ = 0;
 };
 
 }  // namespace sg::grasp

@@ -19,6 +19,13 @@ GraspSettings read_grasp_settings(const Config& config) {
            "s after the arm stops: no sighting that close by then = not held");
   g.number("default_delay", s.default_delay, Range::above_to(0, 10),
            "s per controller command until ARM_STATUS has measured one");
+  g.number("heartbeat_period", s.heartbeat_period, Range::closed(0.01, 1.0),
+           "s between ARM_COMMAND heartbeats while sg-grasp wants the arm (keep it well below "
+           "arm_driver.commander_timeout)");
+  g.number("resend_after", s.resend_after, Range::closed(0.05, 10),
+           "s: a request that ARM_STATUS does not show received is sent again (same sequence)");
+  g.number("arm_status_timeout", s.arm_status_timeout, Range::closed(0.1, 60),
+           "s without ARM_STATUS: no request and no heartbeat until it returns");
   g.flag("use_prediction", s.use_prediction,
          "false: aim at the last measured position (the baseline)");
   g.number("table_z", i.table_z, Range::closed(-2, 2), "m: the table top in the robot's frame");

@@ -1,7 +1,9 @@
 // sg-grasp: the grasp state machine (section 6, figure 4) over LCM. Reads the predicted path
 // (OBJECT_TRAJECTORY), the measurements (OBJECT_POSITION), the arm (ARM_STATUS) and the operator
 // (GRASP_COMMAND); sends ARM_COMMAND, one at a time, each aimed where the ball will be when the
-// gripper gets there; publishes GRASP_STATUS on every change and at --status-rate.
+// gripper gets there, and heartbeats while it wants the arm (the driver's watchdog stops the arm
+// when they stop); publishes GRASP_STATUS on every change and at --status-rate. It moves nothing
+// until an operator asks.
 //
 //   sg-grasp                         # then: sg-grasp-ctl track; sg-grasp-ctl grasp
 //   sg-grasp --no-prediction         # aim at the last measured position (the baseline)
@@ -56,9 +58,10 @@ int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
   while (!sg::shutdown_requested()) {
     bus.handle(std::chrono::milliseconds(10));
     const sg::grasp::GraspNode::Output out = node.poll(sg::now_utime());
-    if (out.arm_command) {
-      stereograsp::arm_cmd_t command = *out.arm_command;
-      lab.sign("ARM_COMMAND", command);
+    for (const auto& arm_command : {out.arm_command, out.lease}) {  // the request first
+      if (!arm_command) continue;
+      stereograsp::arm_cmd_t command = *arm_command;
+      lab.sign("ARM_COMMAND", command);  // every one, resends and heartbeats too: a new counter
       bus.publish("ARM_COMMAND", command);
     }
     if (out.status) bus.publish("GRASP_STATUS", *out.status);

@@ -2,7 +2,10 @@
 // grasp q0 -> q4 judged a success and a failure, abort from every state, a lost track during the
 // approach, no command from a stale or lost trajectory, workspace and table refusals, one request
 // in flight, the delay learning and the --no-prediction mode; each command's reply, and the
-// precedence of the one-off requests (STOP over a0 over home, lift and back-off). Fresh
+// precedence of the one-off requests (STOP over a0 over home, lift and back-off); a start that
+// sends nothing unasked (q3 when the gripper is reported closed), resends under the same
+// sequence, none across a driver restart, a silent ARM_STATUS, the back-off after rejections,
+// the commander lease's rejection message and what the machine asks of the lease. Fresh
 // trajectories are a synthetic circle (centre (0.45, 0, 0.10) m, radius 0.15 m, 1 rpm as in the
 // paper) sampled at 4 Hz.
 
@@ -18,6 +21,7 @@
 #include <vector>
 
 #include "stereograsp/arm_cmd_t.hpp"
+#include "stereograsp/arm_status_t.hpp"
 
 namespace sg::grasp {
 namespace {
@@ -28,6 +32,7 @@ using arm::pose_from_xyz_rpy;
 using arm::solve_nearest;
 
 using Cmd = stereograsp::arm_cmd_t;
+using Status = stereograsp::arm_status_t;
 
 constexpr double kPi = std::numbers::pi;
 constexpr int64_t kSecond = 1'000'000;
@@ -92,10 +97,13 @@ Req kind(const std::optional<ArmRequest>& r) {
   return Req::kNone;
 }
 
-/// A machine, a connected arm at the ready pose and a clock.
+/// A machine, a connected arm at the ready pose with the hand reported open, and a clock. The
+/// arm's driver receives every request taken and publishes its status before each take().
 struct Rig {
-  explicit Rig(GraspSettings s = {}) : settings(s), machine(geometry, s, 100) {
+  explicit Rig(GraspSettings s = {}, int8_t gripper = Status::GRIPPER_OPEN)
+      : settings(s), machine(geometry, s, 100) {
     arm.connected = true;
+    arm.gripper = gripper;
     arm.joints = ready_joints();
     arm.tool = forward_kinematics(geometry, arm.joints).translation();
     machine.on_arm_status(arm, now);
@@ -110,7 +118,12 @@ struct Rig {
   }
   void advance(double seconds) { now += std::llround(seconds * kSecond); }
   void command(GraspCommand c, double standoff = 0) { machine.on_command(c, standoff, now); }
-  std::optional<ArmRequest> take() { return machine.take_request(now); }
+  std::optional<ArmRequest> take() {
+    machine.on_arm_status(arm, now);  // the driver publishes at 10 Hz
+    std::optional<ArmRequest> r = machine.take_request(now);
+    if (r) arm.last_received_sequence = r->sequence;
+    return r;
+  }
   const GraspStatusView& status() const { return machine.status(); }
 
   /// The arm reports `r` executed; a Cartesian target moves the arm there (its inverse
@@ -122,10 +135,14 @@ struct Rig {
       arm.tool = forward_kinematics(geometry, arm.joints).translation();
     }
     arm.last_executed_sequence = r.sequence;
+    if (r.gripper == Cmd::GRIPPER_OPEN) arm.gripper = Status::GRIPPER_OPEN;
+    if (r.gripper == Cmd::GRIPPER_CLOSE) arm.gripper = Status::GRIPPER_CLOSED;
     arm.moving = moving;
     if (interaction_time > 0) arm.interaction_time = interaction_time;
     machine.on_arm_status(arm, now);
   }
+  /// The driver's next ARM_STATUS, unchanged.
+  void publish() { machine.on_arm_status(arm, now); }
   void rejected(const ArmRequest& r) {
     arm.last_rejected_sequence = r.sequence;
     machine.on_arm_status(arm, now);
@@ -189,8 +206,7 @@ const char* name(At at) {
 
 /// Brings `rig` (fresh from its constructor) to `at`, answering every request on the way.
 void reach(Rig& rig, At at) {
-  ASSERT_EQ(kind(rig.take()), Req::kOpen);  // a0 first
-  rig.executed(ArmRequest{100});
+  ASSERT_EQ(kind(rig.take()), Req::kNone);  // nothing unasked
   rig.advance(0.8);
   rig.feed();
   switch (at) {
@@ -223,6 +239,7 @@ void reach(Rig& rig, At at) {
   rig.advance(0.8);
   if (at == At::kQ3Idle) {
     rig.rejected(*lift);
+    rig.advance(GraspMachine::kRetryFirst);  // the back-off after the rejection
     return;
   }
   rig.executed(*lift, true);
@@ -368,24 +385,74 @@ TEST(GraspMachineTest, RefusedCommandsSayWhy) {
   EXPECT_NE(holding.status().message.find("release the object first"), std::string::npos);
 }
 
-// The first request, once the arm is connected, is a0: open the hand.
-TEST(GraspMachineTest, FirstRequestOpensTheHandOnceConnected) {
+// A start sends nothing unasked: no request before the first ARM_STATUS, none after it (the
+// hand reported unknown), none for seconds after; the first command's request is sequence 7.
+TEST(GraspMachineTest, StartSendsNothingUntilCommanded) {
   GraspMachine machine(ArmGeometry::a465(), {}, 7);
   EXPECT_FALSE(machine.take_request(kT0).has_value());  // no arm status yet
   ArmView arm;
-  arm.connected = false;
-  machine.on_arm_status(arm, kT0);
-  EXPECT_FALSE(machine.take_request(kT0).has_value());
   arm.connected = true;
-  machine.on_arm_status(arm, kT0 + 1000);
-  const std::optional<ArmRequest> r = machine.take_request(kT0 + 1000);
-  ASSERT_TRUE(r.has_value());
-  EXPECT_EQ(r->sequence, 7);
-  EXPECT_EQ(r->mode, Cmd::MODE_GRIPPER_ONLY);
-  EXPECT_EQ(r->gripper, Cmd::GRIPPER_OPEN);
-  EXPECT_EQ(machine.status().last_action, GraspAction::kOpenHand);
+  arm.joints = ready_joints();
+  for (int i = 0; i <= 30; ++i) {  // 3 s of statuses at 10 Hz
+    machine.on_arm_status(arm, kT0 + i * 100'000);
+    EXPECT_FALSE(machine.take_request(kT0 + i * 100'000).has_value());
+    EXPECT_EQ(machine.arm_need(kT0 + i * 100'000), ArmNeed::kNone);
+  }
   EXPECT_EQ(machine.status().state, GraspState::kHandOpened);
   EXPECT_EQ(machine.status().activity, GraspActivity::kIdle);
+  EXPECT_EQ(machine.status().last_action, GraspAction::kNone);
+  EXPECT_EQ(machine.next_action(), NextAction::kNone);
+  machine.on_command(GraspCommand::kHome, 0, kT0 + 3'000'000);
+  const std::optional<ArmRequest> home = machine.take_request(kT0 + 3'000'000);
+  ASSERT_TRUE(home.has_value());
+  EXPECT_EQ(home->sequence, 7);
+  EXPECT_EQ(home->mode, Cmd::MODE_HOME);
+}
+
+// A restart with the gripper reported CLOSED (the arm may hold the ball): q3 hand closed, idle,
+// nothing sent; track and grasp are refused, release sends a0 (q0), and only then.
+TEST(GraspMachineTest, RestartWithTheGripperClosedIsQ3IdleAndSendsNothing) {
+  Rig rig({}, Status::GRIPPER_CLOSED);
+  rig.arm.moving = true;  // still moving from the previous sg-grasp's command (sequence 55)
+  rig.arm.last_executed_sequence = 55;
+  rig.feed();
+  for (int i = 0; i < 20; ++i) {
+    rig.advance(0.1);
+    rig.feed();
+    EXPECT_EQ(kind(rig.take()), Req::kNone);
+    EXPECT_EQ(rig.machine.arm_need(rig.now), ArmNeed::kNone);  // not its motion: no heartbeat
+  }
+  EXPECT_EQ(rig.status().state, GraspState::kHandClosed);
+  EXPECT_EQ(rig.status().activity, GraspActivity::kIdle);
+  EXPECT_EQ(rig.machine.on_command(GraspCommand::kTrack, 0, rig.now).result,
+            CommandResult::kRefusedState);
+  EXPECT_EQ(rig.machine.on_command(GraspCommand::kGrasp, 0, rig.now).result,
+            CommandResult::kRefusedState);
+  EXPECT_EQ(kind(rig.take()), Req::kNone);
+  EXPECT_EQ(rig.machine.on_command(GraspCommand::kRelease, 0, rig.now).result,
+            CommandResult::kAccepted);
+  const std::optional<ArmRequest> open = rig.take();
+  ASSERT_EQ(kind(open), Req::kOpen);
+  EXPECT_EQ(open->sequence, 100);
+  EXPECT_EQ(rig.status().state, GraspState::kHandOpened);
+}
+
+// A track asked for before the first ARM_STATUS, which then reports the gripper CLOSED: q3 idle,
+// the track cancelled with a message, nothing sent.
+TEST(GraspMachineTest, ClosedGripperAtTheFirstStatusCancelsAnEarlierTrack) {
+  GraspMachine machine(ArmGeometry::a465(), {}, 7);
+  machine.on_trajectory(circle_path(kT0), kT0 - 50'000, kT0);
+  EXPECT_EQ(machine.on_command(GraspCommand::kTrack, 0, kT0).result, CommandResult::kAccepted);
+  ArmView arm;
+  arm.connected = true;
+  arm.joints = ready_joints();
+  arm.gripper = Status::GRIPPER_CLOSED;
+  machine.on_arm_status(arm, kT0 + 10'000);
+  EXPECT_FALSE(machine.take_request(kT0 + 10'000).has_value());
+  EXPECT_EQ(machine.status().state, GraspState::kHandClosed);
+  EXPECT_EQ(machine.status().activity, GraspActivity::kIdle);
+  EXPECT_EQ(machine.status().message,
+            "the gripper is reported closed: q3 hand closed, track cancelled (release first)");
 }
 
 // Tracking aims at the ball's predicted position at arrival, the stand-off above it, and a
@@ -674,7 +741,7 @@ TEST(GraspMachineTest, AtMostOneRequestInFlight) {
   reach(rig, At::kQ0Tracking);
   const std::optional<ArmRequest> first = rig.take();
   ASSERT_TRUE(first.has_value());
-  EXPECT_EQ(first->sequence, 101);
+  EXPECT_EQ(first->sequence, 100);
   for (int i = 0; i < 3; ++i) {
     rig.advance(0.25);
     rig.feed();
@@ -686,17 +753,17 @@ TEST(GraspMachineTest, AtMostOneRequestInFlight) {
   rig.executed(*first);
   const std::optional<ArmRequest> second = rig.take();
   ASSERT_TRUE(second.has_value());
-  EXPECT_EQ(second->sequence, 102);
+  EXPECT_EQ(second->sequence, 101);
   EXPECT_FALSE(rig.take().has_value());
   rig.command(GraspCommand::kAbort);
   const std::optional<ArmRequest> stop = rig.take();
   ASSERT_EQ(kind(stop), Req::kStop);
-  EXPECT_EQ(stop->sequence, 103);
+  EXPECT_EQ(stop->sequence, 102);
   EXPECT_FALSE(rig.take().has_value());
 }
 
 // A request the arm rejects frees the slot and is treated like a refusal: a message, and the
-// machine tries again (an approach goes back to q1).
+// machine tries again after the back-off (an approach goes back to q1).
 TEST(GraspMachineTest, RejectedRequestIsARefusal) {
   Rig rig;
   reach(rig, At::kQ0Tracking);
@@ -705,15 +772,18 @@ TEST(GraspMachineTest, RejectedRequestIsARefusal) {
   rig.rejected(*r);
   EXPECT_NE(rig.status().message.find("rejected"), std::string::npos);
   EXPECT_EQ(rig.status().activity, GraspActivity::kTracking);
+  rig.advance(GraspMachine::kRetryFirst);
+  rig.feed();
   EXPECT_TRUE(rig.take().has_value());
 
   Rig approach;
   reach(approach, At::kQ2);
-  const ArmRequest sent{approach.arm.last_executed_sequence + 1};
+  const ArmRequest sent{approach.arm.last_received_sequence};  // the approach
   approach.rejected(sent);
   EXPECT_EQ(approach.status().state, GraspState::kApproaching);
   EXPECT_EQ(approach.status().last_action, GraspAction::kApproachObject);
   EXPECT_NE(approach.status().message.find("rejected the approach"), std::string::npos);
+  approach.advance(GraspMachine::kRetryFirst);
   approach.feed();
   EXPECT_EQ(kind(approach.take()), Req::kApproach);
 }
@@ -739,9 +809,11 @@ TEST(GraspMachineTest, UnansweredRequestTimesOut) {
 TEST(GraspMachineTest, LearnsTheDelay) {
   Rig rig;
   EXPECT_DOUBLE_EQ(rig.machine.delay_estimate(), 0.78);
-  const std::optional<ArmRequest> open = rig.take();  // a0: one command (OPEN)
-  ASSERT_TRUE(open.has_value());
-  rig.executed(*open, false, 0.90);
+  rig.feed();
+  rig.command(GraspCommand::kTrack);
+  const std::optional<ArmRequest> move = rig.take();  // a tracking move: one command (MA)
+  ASSERT_EQ(kind(move), Req::kMove) << rig.status().message;
+  rig.executed(*move, false, 0.90);
   const double after_one = 0.7 * 0.78 + 0.3 * 0.90;
   EXPECT_NEAR(rig.machine.delay_estimate(), after_one, 1e-12);
   rig.machine.on_arm_status(rig.arm, rig.now);  // the same interaction again: not counted twice
@@ -751,6 +823,7 @@ TEST(GraspMachineTest, LearnsTheDelay) {
   rig.machine.on_arm_status(rig.arm, rig.now);
   EXPECT_NEAR(rig.machine.delay_estimate(), after_one, 1e-12);
 
+  rig.advance(0.9);
   rig.feed();
   rig.command(GraspCommand::kGrasp);
   const std::optional<ArmRequest> approach = rig.take();  // MA + CLOSE: two delays
@@ -769,8 +842,7 @@ TEST(GraspMachineTest, NoPredictionAimsAtTheLastMeasurement) {
   GraspSettings settings;
   settings.use_prediction = false;
   Rig rig(settings);
-  ASSERT_EQ(kind(rig.take()), Req::kOpen);
-  rig.executed(ArmRequest{100});
+  ASSERT_EQ(kind(rig.take()), Req::kNone);  // nothing unasked
   rig.feed();  // its points are ignored; it only says the track is alive
   rig.command(GraspCommand::kTrack);
   EXPECT_FALSE(rig.take().has_value());  // nothing measured yet
@@ -790,8 +862,7 @@ TEST(GraspMachineTest, NoPredictionAimsAtTheLastMeasurement) {
   EXPECT_LT((approach->position - ball).norm(), 1e-9);
 
   Rig stale(settings);
-  ASSERT_EQ(kind(stale.take()), Req::kOpen);
-  stale.executed(ArmRequest{100});
+  ASSERT_EQ(kind(stale.take()), Req::kNone);
   stale.command(GraspCommand::kTrack);
   stale.machine.on_measurement(ball, stale.now - 1'100'000);
   EXPECT_FALSE(stale.take().has_value());
@@ -890,6 +961,7 @@ TEST(GraspMachineTest, OpenGoesBeforeAHomeAndIsRetriedFirst) {
   EXPECT_EQ(rig.machine.next_action(), NextAction::kHome);
   rig.rejected(*open);
   EXPECT_EQ(rig.machine.next_action(), NextAction::kOpen);
+  rig.advance(GraspMachine::kRetryFirst);  // the back-off
   const std::optional<ArmRequest> again = rig.take();
   ASSERT_EQ(kind(again), Req::kOpen);
   EXPECT_EQ(rig.machine.next_action(), NextAction::kHome);
@@ -898,13 +970,14 @@ TEST(GraspMachineTest, OpenGoesBeforeAHomeAndIsRetriedFirst) {
   EXPECT_EQ(rig.status().activity, GraspActivity::kHoming);
 }
 
-// A grasp asked for before the first a0 went out: a0 first, the state stays q1, and the approach
-// follows (a0 in q1 does not undo the grasp).
-TEST(GraspMachineTest, GraspBeforeTheFirstOpenApproachesAfterIt) {
-  Rig rig;
+// A grasp asked for in q0 while the gripper is not reported OPEN (unknown after a start): a0
+// first, the state stays q1, and the approach follows (a0 in q1 does not undo the grasp).
+TEST(GraspMachineTest, GraspWithTheHandNotReportedOpenOpensFirst) {
+  Rig rig({}, Status::GRIPPER_UNKNOWN);
   rig.feed();
-  EXPECT_EQ(rig.machine.next_action(), NextAction::kOpen);
+  EXPECT_EQ(rig.machine.next_action(), NextAction::kNone);
   rig.command(GraspCommand::kGrasp);
+  EXPECT_EQ(rig.machine.next_action(), NextAction::kOpen);
   EXPECT_EQ(rig.status().state, GraspState::kApproaching);
   const std::optional<ArmRequest> open = rig.take();
   ASSERT_EQ(kind(open), Req::kOpen);
@@ -917,7 +990,7 @@ TEST(GraspMachineTest, GraspBeforeTheFirstOpenApproachesAfterIt) {
 
 // A back-off that the lost track calls for while a0 is pending goes out after the a0.
 TEST(GraspMachineTest, OpenGoesBeforeABackoff) {
-  Rig rig;
+  Rig rig({}, Status::GRIPPER_UNKNOWN);
   rig.feed();
   rig.command(GraspCommand::kGrasp);
   rig.lose();
@@ -946,6 +1019,188 @@ TEST(GraspMachineTest, AbortHidesTheLift) {
   EXPECT_EQ(rig.machine.next_action(), NextAction::kNone);
   rig.executed(*stop);
   EXPECT_FALSE(rig.take().has_value());
+}
+
+// A request that ARM_STATUS does not show received (the driver never got it) is sent again with
+// the same sequence and content 0.5 s after it was sent and 0.5 s after each resend; once the
+// status shows it received, never again.
+TEST(GraspMachineTest, ResendsALostRequestUnderTheSameSequence) {
+  Rig rig;
+  reach(rig, At::kQ0Tracking);
+  const std::optional<ArmRequest> first = rig.machine.take_request(rig.now);  // lost on the way
+  ASSERT_EQ(kind(first), Req::kMove) << rig.status().message;
+  const int64_t sent = rig.now;
+  for (int64_t after : {100'000, 300'000, 499'999}) {
+    rig.now = sent + after;
+    rig.feed();
+    rig.publish();
+    EXPECT_FALSE(rig.machine.take_request(rig.now).has_value()) << after;
+  }
+  rig.now = sent + 500'000;
+  rig.publish();
+  const std::optional<ArmRequest> again = rig.machine.take_request(rig.now);
+  ASSERT_TRUE(again.has_value());
+  EXPECT_EQ(again->sequence, first->sequence);
+  EXPECT_EQ(again->mode, first->mode);
+  EXPECT_TRUE(again->position == first->position);
+  EXPECT_TRUE(again->rpy == first->rpy);
+  EXPECT_EQ(again->target_utime, first->target_utime);
+  EXPECT_EQ(again->source_utime, first->source_utime);
+  EXPECT_EQ(rig.machine.resends(), 1u);
+  rig.now = sent + 999'999;
+  rig.publish();
+  EXPECT_FALSE(rig.machine.take_request(rig.now).has_value());
+  rig.now = sent + 1'000'000;
+  rig.publish();
+  ASSERT_TRUE(rig.machine.take_request(rig.now).has_value());
+  EXPECT_EQ(rig.machine.resends(), 2u);
+  rig.arm.last_received_sequence = first->sequence;  // it arrived: the driver has it
+  for (int i = 1; i <= 10; ++i) {
+    rig.now = sent + 1'000'000 + i * 100'000;
+    rig.publish();
+    EXPECT_FALSE(rig.machine.take_request(rig.now).has_value());
+  }
+  EXPECT_EQ(rig.machine.resends(), 2u);
+}
+
+// A driver restart (driver_start_utime changes) with a request in flight: not resent (the old
+// driver may have executed it); abandoned as failed, "driver restarted", and the next request is
+// computed afresh at once under a new sequence.
+TEST(GraspMachineTest, NoResendAcrossADriverRestart) {
+  Rig rig;
+  rig.arm.driver_start_utime = kT0 - 3600 * kSecond;
+  rig.publish();
+  reach(rig, At::kQ0Tracking);
+  const std::optional<ArmRequest> first = rig.machine.take_request(rig.now);
+  ASSERT_EQ(kind(first), Req::kMove) << rig.status().message;
+  rig.advance(0.3);
+  rig.arm.driver_start_utime = rig.now - 200'000;  // a new driver process
+  rig.arm.last_received_sequence = -1;
+  rig.feed();
+  rig.publish();
+  EXPECT_EQ(rig.status().message, "driver restarted: abandoned the tracking target (request " +
+                                      std::to_string(first->sequence) + ")");
+  const std::optional<ArmRequest> fresh = rig.machine.take_request(rig.now);
+  ASSERT_EQ(kind(fresh), Req::kMove) << rig.status().message;
+  EXPECT_EQ(fresh->sequence, first->sequence + 1);
+  EXPECT_EQ(rig.machine.resends(), 0u);
+  EXPECT_EQ(rig.machine.consecutive_rejections(), 0);
+}
+
+// No ARM_STATUS for more than arm_status_timeout (1 s): no request and no heartbeat (arm_need
+// silent), the silence reported; when statuses return, requests resume. An abort's STOP goes
+// out regardless.
+TEST(GraspMachineTest, SilentArmStatusStopsRequestsAndHeartbeats) {
+  Rig rig;
+  reach(rig, At::kQ0Tracking);
+  const ArmRequest first = rig.run();
+  EXPECT_EQ(rig.machine.arm_need(rig.now), ArmNeed::kWanted);
+  rig.advance(1.0);
+  rig.feed();
+  EXPECT_FALSE(rig.machine.arm_status_silence(rig.now).has_value());  // 1.0 s: not yet
+  rig.advance(0.3);
+  rig.feed();
+  EXPECT_FALSE(rig.machine.take_request(rig.now).has_value());
+  ASSERT_TRUE(rig.machine.arm_status_silence(rig.now).has_value());
+  EXPECT_NEAR(*rig.machine.arm_status_silence(rig.now), 1.3, 1e-9);
+  EXPECT_EQ(rig.machine.arm_need(rig.now), ArmNeed::kSilent);
+  rig.publish();  // statuses return
+  EXPECT_FALSE(rig.machine.arm_status_silence(rig.now).has_value());
+  EXPECT_EQ(rig.machine.arm_need(rig.now), ArmNeed::kWanted);
+  const std::optional<ArmRequest> next = rig.machine.take_request(rig.now);
+  ASSERT_EQ(kind(next), Req::kMove);
+  EXPECT_EQ(next->sequence, first.sequence + 1);
+  rig.advance(1.5);
+  rig.command(GraspCommand::kAbort);
+  EXPECT_EQ(kind(rig.machine.take_request(rig.now)), Req::kStop);
+}
+
+// After the k-th consecutive rejection the next request waits min(0.25 s * 2^(k-1), 4 s):
+// 0.25, 0.5, 1, 2, 4 and 4 s; an executed request resets the count.
+TEST(GraspMachineTest, RejectionsAreBackedOff) {
+  Rig rig;
+  reach(rig, At::kQ0Tracking);
+  std::optional<ArmRequest> r = rig.take();
+  ASSERT_TRUE(r.has_value());
+  int k = 0;
+  for (double wait : {0.25, 0.5, 1.0, 2.0, 4.0, 4.0}) {
+    SCOPED_TRACE(wait);
+    rig.rejected(*r);
+    EXPECT_EQ(rig.machine.consecutive_rejections(), ++k);
+    const int64_t at = rig.now;
+    rig.now = at + std::llround(wait * kSecond) - 1000;
+    rig.feed();
+    EXPECT_FALSE(rig.take().has_value());
+    rig.now = at + std::llround(wait * kSecond);
+    rig.feed();
+    r = rig.take();
+    ASSERT_EQ(kind(r), Req::kMove) << rig.status().message;
+  }
+  rig.executed(*r);
+  EXPECT_EQ(rig.machine.consecutive_rejections(), 0);
+  rig.feed();
+  r = rig.take();
+  ASSERT_TRUE(r.has_value());
+  rig.rejected(*r);
+  EXPECT_EQ(rig.machine.retry_utime(), rig.now + 250'000);
+}
+
+// A rejection because another sender holds the commander lease shows as "waiting: arm
+// commanded by '<holder>'" through the retries, and goes when a request is executed; an
+// operator's abort waits for no back-off.
+TEST(GraspMachineTest, LeaseRejectionSaysWhoCommandsTheArm) {
+  Rig rig;
+  reach(rig, At::kQ0Tracking);
+  std::optional<ArmRequest> r = rig.take();
+  ASSERT_TRUE(r.has_value());
+  rig.arm.rejection_reason = "arm commanded by 'sg-arm-ctl@bench:77'";
+  rig.rejected(*r);
+  const std::string waiting = "waiting: arm commanded by 'sg-arm-ctl@bench:77'";
+  EXPECT_EQ(rig.status().message.substr(0, waiting.size()), waiting) << rig.status().message;
+  rig.advance(0.25);
+  rig.feed();
+  r = rig.take();
+  ASSERT_EQ(kind(r), Req::kMove);
+  EXPECT_EQ(rig.status().message.substr(0, waiting.size()), waiting) << rig.status().message;
+  rig.rejected(*r);  // the second: 0.5 s
+  rig.advance(0.1);
+  rig.command(GraspCommand::kAbort);
+  EXPECT_EQ(kind(rig.take()), Req::kStop);  // at once
+  rig.arm.rejection_reason = "";
+  rig.executed(ArmRequest{rig.arm.last_received_sequence});
+  EXPECT_EQ(rig.status().message, "");
+}
+
+// The commander lease: not wanted before a command; wanted while tracking a fresh track; silent
+// (no heartbeat, with the message) when that track goes stale, wanted again when it returns;
+// after an abort wanted while the STOP is in flight and the arm still moves from it, then none.
+TEST(GraspMachineTest, ArmNeedFollowsTheTrackAndTheArm) {
+  Rig rig;
+  rig.feed();
+  EXPECT_EQ(rig.machine.arm_need(rig.now), ArmNeed::kNone);
+  rig.command(GraspCommand::kTrack);
+  EXPECT_EQ(rig.machine.arm_need(rig.now), ArmNeed::kWanted);
+  const ArmRequest move = rig.run(true);
+  rig.advance(1.1);  // the trajectory is older than max_trajectory_age
+  rig.publish();
+  EXPECT_EQ(rig.machine.arm_need(rig.now), ArmNeed::kSilent);
+  EXPECT_EQ(rig.status().message,
+            "no fresh track of the object: heartbeats stopped (the driver's watchdog stops the "
+            "arm)");
+  rig.feed();
+  EXPECT_EQ(rig.machine.arm_need(rig.now), ArmNeed::kWanted);
+  EXPECT_EQ(rig.status().message, "");
+  rig.command(GraspCommand::kAbort);
+  EXPECT_EQ(rig.machine.arm_need(rig.now), ArmNeed::kWanted);  // the STOP planned
+  const std::optional<ArmRequest> stop = rig.take();
+  ASSERT_EQ(kind(stop), Req::kStop);
+  EXPECT_EQ(rig.machine.arm_need(rig.now), ArmNeed::kWanted);  // in flight
+  rig.executed(*stop, true);
+  EXPECT_EQ(rig.machine.arm_need(rig.now), ArmNeed::kWanted);  // its own command still moving
+  rig.arm.moving = false;
+  rig.publish();
+  EXPECT_EQ(rig.machine.arm_need(rig.now), ArmNeed::kNone);
+  EXPECT_GT(stop->sequence, move.sequence);
 }
 
 // The names shown on GRASP_STATUS and in logs.

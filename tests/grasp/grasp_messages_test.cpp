@@ -59,7 +59,15 @@ TEST(GraspMessages, ArmStatusToView) {
   s.joints[5] = 0.5;
   s.tool_position[2] = 0.25;
   s.interaction_time = 0.78;
+  s.gripper = arm_status_t::GRIPPER_CLOSED;
+  s.last_received_sequence = 4;
+  s.rejection_reason = "arm commanded by 'x'";
+  s.driver_start_utime = 1'790'000'000'000'000;
   ArmView v = arm_view_of(s);
+  EXPECT_EQ(v.gripper, arm_status_t::GRIPPER_CLOSED);
+  EXPECT_EQ(v.last_received_sequence, 4);
+  EXPECT_EQ(v.rejection_reason, "arm commanded by 'x'");
+  EXPECT_EQ(v.driver_start_utime, 1'790'000'000'000'000);
   EXPECT_TRUE(v.connected);
   EXPECT_TRUE(v.moving);
   EXPECT_FALSE(v.error);

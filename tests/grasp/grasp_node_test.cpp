@@ -1,8 +1,10 @@
 // sg-grasp's logic without the bus (GraspNode): the per-sender sequence check and the range
 // checks of GRASP_COMMAND, the answer to every command on GRASP_STATUS (command_sequence,
-// command_result, command_reason), at most one ARM_COMMAND per poll with the newest trajectory's
-// utime, and GRASP_STATUS on a change and once per status period. The ball is still at
-// (0.45, 0, 0.10) m; the arm is at its ready pose.
+// command_result, command_reason), at most one request per poll with the newest trajectory's
+// utime, and GRASP_STATUS on a change and once per status period; nothing sent after a restart
+// until commanded, heartbeats every period and one release, none with a stale track or a silent
+// ARM_STATUS (reported), a resend as the very same message, and no storm of rejected commands.
+// The ball is still at (0.45, 0, 0.10) m; the arm is at its ready pose.
 
 #include "grasp/grasp_node.hpp"
 
@@ -12,6 +14,7 @@
 #include <limits>
 #include <numbers>
 #include <string>
+#include <vector>
 
 namespace sg::grasp {
 namespace {
@@ -53,7 +56,7 @@ struct Rig {
   void feed() { EXPECT_EQ(node.on_trajectory(trajectory(), now), ""); }
   void connect() { node.on_arm_status(arm, now); }
   void executed(const arm_cmd_t& c) {
-    arm.last_executed_sequence = c.sequence;
+    arm.last_received_sequence = arm.last_executed_sequence = c.sequence;
     node.on_arm_status(arm, now);
   }
   const CommandRecord& command(int8_t command, int64_t sequence, double standoff = 0,
@@ -67,6 +70,27 @@ struct Rig {
     return node.on_command(m, now);
   }
   GraspNode::Output poll() { return node.poll(now); }
+  /// The driver's next ARM_STATUS, unchanged.
+  void publish() {
+    arm.utime = now;
+    node.on_arm_status(arm, now);
+  }
+  /// Runs the loop for `seconds`: a poll every 10 ms, ARM_STATUS every 100 ms (when `statuses`),
+  /// a trajectory every 250 ms (when `trajectories`); the driver receives every request (it
+  /// executes none); the outputs in order.
+  std::vector<GraspNode::Output> run(double seconds, bool statuses = true,
+                                     bool trajectories = true) {
+    std::vector<GraspNode::Output> out;
+    const int64_t end = now + std::llround(seconds * kSecond);
+    for (int64_t step = 0; now < end; ++step) {
+      now += 10'000;
+      if (statuses && step % 10 == 9) publish();
+      if (trajectories && step % 25 == 24) feed();
+      out.push_back(poll());
+      if (out.back().arm_command) arm.last_received_sequence = out.back().arm_command->sequence;
+    }
+    return out;
+  }
   void advance(double seconds) { now += std::llround(seconds * kSecond); }
 
   GraspNode node;
@@ -175,24 +199,26 @@ TEST(GraspNodeTest, RemembersABoundedNumberOfSenders) {
             CommandResult::kRefusedNotNewer);
 }
 
-// One ARM_COMMAND per poll: a0 first, nothing while it is in flight, then the tracking move;
-// abort then home gives STOP and, after it is executed, HOME, one poll each. The utime is the
-// newest trajectory's (the clock's before any).
+// One request per poll: nothing unasked, then the HOME asked for, nothing while it is in flight,
+// then the tracking move; abort then home gives STOP and, after it is executed, HOME, one poll
+// each. The utime is the newest trajectory's (the clock's before any).
 TEST(GraspNodeTest, OneArmCommandPerPoll) {
   Rig rig;
   rig.connect();
+  EXPECT_FALSE(rig.poll().arm_command.has_value());  // nothing unasked
+  rig.command(grasp_command_t::COMMAND_HOME, 1);
   const GraspNode::Output open = rig.poll();
   ASSERT_TRUE(open.arm_command.has_value());
   EXPECT_EQ(open.arm_command->sequence, 100);
-  EXPECT_EQ(open.arm_command->mode, arm_cmd_t::MODE_GRIPPER_ONLY);
+  EXPECT_EQ(open.arm_command->mode, arm_cmd_t::MODE_HOME);
   EXPECT_EQ(open.arm_command->utime, kT0);  // no trajectory yet: the clock
   EXPECT_EQ(open.arm_command->sender, "sg-grasp");
   rig.advance(0.1);
   rig.feed();
   const int64_t trajectory_utime = rig.now;
-  rig.command(grasp_command_t::COMMAND_TRACK, 1);
-  EXPECT_FALSE(rig.poll().arm_command.has_value());  // a0 in flight
-  rig.advance(0.7);
+  rig.command(grasp_command_t::COMMAND_TRACK, 2);
+  EXPECT_FALSE(rig.poll().arm_command.has_value());  // HOME in flight
+  rig.advance(0.3);
   rig.executed(*open.arm_command);
   const GraspNode::Output move = rig.poll();
   ASSERT_TRUE(move.arm_command.has_value()) << rig.node.machine().status().message;
@@ -201,8 +227,8 @@ TEST(GraspNodeTest, OneArmCommandPerPoll) {
   EXPECT_EQ(move.arm_command->utime, trajectory_utime);
   EXPECT_NEAR(move.arm_command->position[2], 0.20, 1e-9);  // the stand-off above the ball
   EXPECT_FALSE(rig.poll().arm_command.has_value());
-  rig.command(grasp_command_t::COMMAND_ABORT, 2);
-  rig.command(grasp_command_t::COMMAND_HOME, 3);
+  rig.command(grasp_command_t::COMMAND_ABORT, 3);
+  rig.command(grasp_command_t::COMMAND_HOME, 4);
   const GraspNode::Output stop = rig.poll();
   ASSERT_TRUE(stop.arm_command.has_value());
   EXPECT_EQ(stop.arm_command->mode, arm_cmd_t::MODE_STOP);
@@ -231,11 +257,12 @@ TEST(GraspNodeTest, StatusOnChangeAndOnPeriod) {
   ASSERT_TRUE(periodic.status.has_value());
   EXPECT_EQ(periodic.changed_summary, "");
   rig.advance(0.05);
-  rig.connect();  // the machine sends a0: the last action changes
+  rig.connect();
+  rig.command(grasp_command_t::COMMAND_HOME, 1);  // the activity changes
   const GraspNode::Output changed = rig.poll();
   ASSERT_TRUE(changed.status.has_value());
-  EXPECT_EQ(changed.status->last_action, grasp_status_t::A0_OPEN_HAND);
-  EXPECT_EQ(changed.changed_summary, "q0 hand opened, idle, last a0 open hand, outcome none");
+  EXPECT_EQ(changed.status->activity, grasp_status_t::ACTIVITY_HOMING);
+  EXPECT_EQ(changed.changed_summary, "q0 hand opened, homing, last none, outcome none");
   rig.advance(0.2);
   EXPECT_FALSE(rig.poll().status.has_value());  // 0.2 s after the change
   rig.advance(-10.0);                           // the clock stepped back
@@ -251,9 +278,210 @@ TEST(GraspNodeTest, MalformedTrajectoryIsIgnored) {
   m.utime -= kSecond;
   EXPECT_EQ(rig.node.on_trajectory(m, rig.now), "period 0 us (1 ms to 60 s)");
   rig.connect();
+  rig.command(grasp_command_t::COMMAND_HOME, 1);
   const GraspNode::Output open = rig.poll();
   ASSERT_TRUE(open.arm_command.has_value());
   EXPECT_EQ(open.arm_command->utime, rig.now);  // no trajectory yet: the node's time
+}
+
+/// The utimes of the heartbeats in `outputs`.
+std::vector<int64_t> heartbeat_times(const std::vector<GraspNode::Output>& outputs) {
+  std::vector<int64_t> times;
+  for (const GraspNode::Output& o : outputs) {
+    if (o.lease && o.lease->mode == arm_cmd_t::MODE_HEARTBEAT) times.push_back(o.lease->utime);
+  }
+  return times;
+}
+
+/// How many outputs carry a request (new or resent) / a lease command of `mode`.
+int requests(const std::vector<GraspNode::Output>& outputs) {
+  int n = 0;
+  for (const GraspNode::Output& o : outputs) n += o.arm_command.has_value();
+  return n;
+}
+int leases(const std::vector<GraspNode::Output>& outputs, int8_t mode) {
+  int n = 0;
+  for (const GraspNode::Output& o : outputs) n += o.lease && o.lease->mode == mode;
+  return n;
+}
+
+// A restarted sg-grasp, the arm's gripper reported CLOSED and fresh trajectories coming: 3 s of
+// the loop send no ARM_COMMAND at all (no request, heartbeat or release), and GRASP_STATUS shows
+// q3 hand closed, idle.
+TEST(GraspNodeTest, RestartWithTheGripperClosedSendsNothing) {
+  Rig rig;
+  rig.arm.gripper = arm_status_t::GRIPPER_CLOSED;
+  rig.arm.state = arm_status_t::STATE_MOVING;  // from the previous sg-grasp's last command
+  rig.arm.last_executed_sequence = 55;
+  rig.publish();
+  rig.feed();
+  const std::vector<GraspNode::Output> out = rig.run(3.0);
+  EXPECT_EQ(requests(out), 0);
+  EXPECT_EQ(leases(out, arm_cmd_t::MODE_HEARTBEAT) + leases(out, arm_cmd_t::MODE_RELEASE), 0);
+  EXPECT_EQ(rig.node.machine().status().state, GraspState::kHandClosed);
+  EXPECT_EQ(rig.node.machine().status().activity, GraspActivity::kIdle);
+  ASSERT_TRUE(out.front().status.has_value());
+  EXPECT_EQ(out.front().status->state, grasp_status_t::Q3_HAND_CLOSED);
+}
+
+// While it wants the arm the node sends a MODE_HEARTBEAT every heartbeat period (0.2 s) from the
+// first request on: the last request's sequence, gripper KEEP, the machine's speed; when it stops
+// wanting it (the STOP executed, the arm at rest) one MODE_RELEASE, then nothing.
+TEST(GraspNodeTest, HeartbeatsEveryPeriodThenOneRelease) {
+  Rig rig;
+  rig.publish();
+  rig.feed();
+  rig.command(grasp_command_t::COMMAND_TRACK, 1);
+  const GraspNode::Output first = rig.poll();
+  ASSERT_TRUE(first.arm_command.has_value());
+  ASSERT_TRUE(first.lease.has_value());
+  EXPECT_EQ(first.lease->mode, arm_cmd_t::MODE_HEARTBEAT);
+  EXPECT_EQ(first.lease->sequence, 100);
+  EXPECT_EQ(first.lease->gripper, arm_cmd_t::GRIPPER_KEEP);
+  EXPECT_DOUBLE_EQ(first.lease->speed, 0.5);
+  EXPECT_EQ(first.lease->utime, kT0);
+  EXPECT_EQ(first.lease->sender, "sg-grasp");
+  rig.arm.last_received_sequence = 100;  // the driver has it (still moving towards it)
+  const std::vector<GraspNode::Output> second = rig.run(1.0);
+  EXPECT_EQ(heartbeat_times(second),
+            (std::vector<int64_t>{kT0 + 200'000, kT0 + 400'000, kT0 + 600'000, kT0 + 800'000,
+                                  kT0 + 1'000'000}));
+  EXPECT_EQ(requests(second), 0);  // the move still in flight
+  rig.command(grasp_command_t::COMMAND_ABORT, 2);
+  const GraspNode::Output stop = rig.poll();
+  ASSERT_TRUE(stop.arm_command.has_value());
+  EXPECT_EQ(stop.arm_command->mode, arm_cmd_t::MODE_STOP);
+  rig.executed(*stop.arm_command);
+  const GraspNode::Output release = rig.poll();
+  ASSERT_TRUE(release.lease.has_value());
+  EXPECT_EQ(release.lease->mode, arm_cmd_t::MODE_RELEASE);
+  EXPECT_EQ(release.lease->sequence, 101);
+  const std::vector<GraspNode::Output> after = rig.run(2.0);
+  EXPECT_EQ(requests(after), 0);
+  EXPECT_EQ(leases(after, arm_cmd_t::MODE_HEARTBEAT) + leases(after, arm_cmd_t::MODE_RELEASE), 0);
+  EXPECT_EQ(rig.node.heartbeats(), 6u);
+  EXPECT_EQ(rig.node.releases(), 1u);
+}
+
+// While tracking, a trajectory older than max_trajectory_age (1 s) stops the heartbeats (no
+// release: the driver's watchdog stops the arm) and GRASP_STATUS says so; they resume with the
+// track.
+TEST(GraspNodeTest, StaleTrajectoryStopsTheHeartbeats) {
+  Rig rig;
+  rig.publish();
+  rig.feed();
+  rig.command(grasp_command_t::COMMAND_TRACK, 1);
+  ASSERT_TRUE(rig.poll().arm_command.has_value());
+  rig.arm.last_received_sequence = 100;  // the driver has it, the arm on its way
+  const int64_t fed = rig.now;
+  const std::vector<GraspNode::Output> silent = rig.run(3.0, true, false);
+  const std::vector<int64_t> beats = heartbeat_times(silent);
+  ASSERT_FALSE(beats.empty());
+  EXPECT_LE(beats.back(), fed + 1'000'000);  // none once the track is older than 1 s
+  EXPECT_GE(beats.back(), fed + 800'000);
+  EXPECT_EQ(leases(silent, arm_cmd_t::MODE_RELEASE), 0);
+  EXPECT_EQ(requests(silent), 0);
+  EXPECT_EQ(rig.node.machine().arm_need(rig.now), ArmNeed::kSilent);
+  std::optional<grasp_status_t> status;
+  for (const GraspNode::Output& o : silent) {
+    if (o.status) status = o.status;
+  }
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->message,
+            "no fresh track of the object: heartbeats stopped (the driver's watchdog stops the "
+            "arm)");
+  rig.feed();
+  const GraspNode::Output back = rig.poll();
+  ASSERT_TRUE(back.lease.has_value());
+  EXPECT_EQ(back.lease->mode, arm_cmd_t::MODE_HEARTBEAT);
+}
+
+// No ARM_STATUS for more than 1 s: no request and no heartbeat, GRASP_STATUS says "ARM_STATUS
+// silent for 1.3 s"; when statuses return, heartbeats and requests resume and the note goes.
+TEST(GraspNodeTest, SilentArmStatusStopsCommandsAndIsReported) {
+  Rig rig;
+  rig.publish();
+  rig.feed();
+  rig.command(grasp_command_t::COMMAND_TRACK, 1);
+  const GraspNode::Output first = rig.poll();
+  ASSERT_TRUE(first.arm_command.has_value());
+  rig.executed(*first.arm_command);
+  const int64_t heard = rig.now;
+  rig.now = heard + 1'300'000;
+  rig.feed();
+  const GraspNode::Output silent = rig.poll();
+  EXPECT_FALSE(silent.arm_command.has_value());
+  EXPECT_FALSE(silent.lease.has_value());
+  ASSERT_TRUE(silent.status.has_value());  // a change: silent
+  EXPECT_EQ(silent.status->message, "ARM_STATUS silent for 1.3 s");
+  EXPECT_EQ(silent.changed_summary,
+            "q0 hand opened, tracking, last none, outcome none "
+            "[ARM_STATUS silent]");
+  const std::vector<GraspNode::Output> more = rig.run(1.0, false, true);
+  EXPECT_EQ(requests(more), 0);
+  EXPECT_EQ(leases(more, arm_cmd_t::MODE_HEARTBEAT) + leases(more, arm_cmd_t::MODE_RELEASE), 0);
+  rig.publish();
+  const GraspNode::Output back = rig.poll();
+  ASSERT_TRUE(back.arm_command.has_value());
+  EXPECT_EQ(back.arm_command->sequence, 101);
+  ASSERT_TRUE(back.lease.has_value());
+  EXPECT_EQ(back.lease->mode, arm_cmd_t::MODE_HEARTBEAT);
+  ASSERT_TRUE(back.status.has_value());
+  EXPECT_EQ(back.status->message.find("silent"), std::string::npos) << back.status->message;
+}
+
+// A request the driver did not receive is resent 0.5 s later as the very same message (sequence,
+// utime, target), and GRASP_STATUS counts it ("ARM_COMMAND resent 1").
+TEST(GraspNodeTest, ResendIsTheSameMessageAndIsShown) {
+  Rig rig;
+  rig.publish();
+  rig.feed();
+  rig.command(grasp_command_t::COMMAND_TRACK, 1);
+  const GraspNode::Output first = rig.poll();
+  ASSERT_TRUE(first.arm_command.has_value());
+  std::vector<GraspNode::Output> out = rig.run(0.49, true, true);
+  EXPECT_EQ(requests(out), 0);
+  rig.now = kT0 + 500'000;
+  const GraspNode::Output again = rig.poll();
+  ASSERT_TRUE(again.arm_command.has_value());
+  EXPECT_EQ(again.arm_command->sequence, first.arm_command->sequence);
+  EXPECT_EQ(again.arm_command->utime, first.arm_command->utime);
+  EXPECT_EQ(again.arm_command->target_utime, first.arm_command->target_utime);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(again.arm_command->position[i], first.arm_command->position[i]);
+  }
+  ASSERT_TRUE(again.status.has_value());
+  EXPECT_EQ(again.status->message, "ARM_COMMAND resent 1");
+}
+
+// A driver that rejects every request (another sender holds the lease) for 20 s: the node sends
+// 8 requests, at 0, 0.35, 0.9, 2.0, 4.1, 8.2, 12.3 and 16.4 s (each rejection seen on the next
+// ARM_STATUS, 0.1 s apart, then the back-off 0.25, 0.5, 1, 2, 4, 4, 4 s), heartbeats at 5 Hz,
+// and GRASP_STATUS says who commands the arm; the old 44,000-command storm is gone.
+TEST(GraspNodeTest, RejectionsDoNotStorm) {
+  Rig rig;
+  rig.publish();
+  rig.feed();
+  rig.command(grasp_command_t::COMMAND_TRACK, 1);
+  rig.arm.rejection_reason = "arm commanded by 'sg-grasp@lab2:4242'";
+  std::vector<int64_t> sent;
+  std::optional<grasp_status_t> status;
+  for (int step = 0; step < 2000; ++step) {
+    const GraspNode::Output o = rig.poll();
+    if (o.arm_command) {
+      sent.push_back((rig.now - kT0) / 10'000);  // in 10 ms
+      rig.arm.last_received_sequence = rig.arm.last_rejected_sequence = o.arm_command->sequence;
+    }
+    if (o.status) status = o.status;
+    rig.now += 10'000;
+    if (step % 10 == 9) rig.publish();
+    if (step % 25 == 24) rig.feed();
+  }
+  EXPECT_EQ(sent, (std::vector<int64_t>{0, 35, 90, 200, 410, 820, 1230, 1640}));
+  EXPECT_NEAR(static_cast<double>(rig.node.heartbeats()), 100, 1);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->message.rfind("waiting: arm commanded by 'sg-grasp@lab2:4242'", 0), 0u)
+      << status->message;
 }
 
 }  // namespace
