@@ -70,9 +70,7 @@ class CommanderLease {
   /// When the holder was last heard (meaningless when free).
   double heard() const { return heard_; }
   /// When the holder loses the lease unless heard again: heard() + timeout; +inf when free.
-  double deadline() const {
-    return held() ? deadline_ : std::numeric_limits<double>::infinity();
-  }
+  double deadline() const { return held() ? deadline_ : std::numeric_limits<double>::infinity(); }
   /// The lease is held and its holder has been silent for the timeout at `t`.
   bool expired(double t) const { return held() && t >= deadline_; }
   double timeout() const { return timeout_; }

@@ -1,9 +1,13 @@
-// sg-arm-ctl: the arm from the lab bench. Sends one ARM_COMMAND and waits until sg-arm-driver
-// reports it executed (or rejected, with the reason), or prints ARM_STATUS. Commands are signed
-// with the lab key (--key, default $SG_LAB_KEY or ~/.config/stereograsp/lab.key; docs/security.md).
+// sg-arm-ctl: the arm from the lab bench. Sends one ARM_COMMAND, keeps the commander lease with
+// heartbeats until sg-arm-driver reports it executed and the arm at rest (or rejected, with the
+// reason), then releases the lease; or prints ARM_STATUS. The lease is taken only when it is free
+// (or its holder silent), or with --take-over; a refusal prints the holder and exits 1. Ctrl-C
+// while the arm moves sends STOP. Commands are signed with the lab key (--key, default
+// $SG_LAB_KEY or ~/.config/stereograsp/lab.key; docs/security.md).
 //
 //   sg-arm-ctl move 0.45 0.0 0.25                   # tool centre point (m), tool pointing down
-//   sg-arm-ctl move 0.45 0.0 0.25 --rpy 3.1416 0 0 --speed 0.2 --wait
+//   sg-arm-ctl move 0.45 0.0 0.25 --rpy 3.1416 0 0 --speed 0.2
+//   sg-arm-ctl --take-over home                     # even while sg-grasp holds the arm
 //   sg-arm-ctl joints 0 10 20 0 60 0 --deg
 //   sg-arm-ctl open | close | home | stop
 //   sg-arm-ctl status [--follow]
@@ -12,6 +16,7 @@
 #include <cstdio>
 #include <numbers>
 
+#include "arm_driver/arm_commander.hpp"
 #include "auth/lab_access.hpp"
 #include "common/bus.hpp"
 #include "common/clock.hpp"
@@ -70,45 +75,36 @@ Cmd make_command(int8_t mode, double speed) {
   c.mode = mode;
   c.gripper = Cmd::GRIPPER_KEEP;
   c.speed = speed;
-  c.sender = "sg-arm-ctl";
+  c.sender = "sg-arm-ctl";  // the signer makes it sg-arm-ctl@host:pid
   return c;
 }
 
-/// Publishes `command` and waits for ARM_STATUS to report it executed or rejected (and, with
-/// `wait_idle`, the arm at rest). Returns the exit code.
-int send(sg::Bus& bus, const Cmd& command, bool wait_idle, double timeout) {
-  Status last{};
-  bool have = false, done = false, rejected = false;
-  bus.subscribe<Status>("ARM_STATUS", [&](const Status& s, const sg::ReceiveInfo&) {
-    last = s;
-    have = true;
-    if (s.last_rejected_sequence == command.sequence) rejected = done = true;
-    if (s.last_executed_sequence >= command.sequence) {
-      done = !wait_idle || s.state == Status::STATE_IDLE || s.state == Status::STATE_ERROR;
-    }
-  });
-  bus.publish("ARM_COMMAND", command);
-  const auto give_up = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout);
-  while (!done && !sg::shutdown_requested() && std::chrono::steady_clock::now() < give_up) {
-    bus.handle(std::chrono::milliseconds(50));
-  }
-  if (!have) {
+/// Sends `command` through an ArmCommander (heartbeats while it runs, the lease released after)
+/// and prints how it ended. Returns the exit code.
+int send(sg::Bus& bus, sg::auth::LabAccess& lab, const Cmd& command, double timeout) {
+  sg::arm::ArmCommander commander(bus, lab);
+  const sg::arm::CommandReport r = commander.execute(command, timeout);
+  using Report = sg::arm::CommandReport;
+  if (!commander.have_status()) {
     throw std::runtime_error(
         "no ARM_STATUS on this bus: is sg-arm-driver running (same --lcm-url)?");
   }
-  if (rejected) {
-    std::printf("command #%lld rejected: %s\n", static_cast<long long>(command.sequence),
-                last.rejection_reason.c_str());
-    return 1;
+  switch (r.result) {
+    case Report::kExecuted:
+      std::printf("command #%lld executed\n", static_cast<long long>(command.sequence));
+      print_status(commander.status());
+      return 0;
+    case Report::kRejected:
+    case Report::kTakenOver:
+    case Report::kInterrupted:
+      std::printf("command #%lld %s: %s\n", static_cast<long long>(command.sequence),
+                  r.result == Report::kRejected ? "rejected" : "not completed", r.reason.c_str());
+      return 1;
+    case Report::kTimedOut:
+      break;
   }
-  if (!done) {
-    print_status(last);
-    throw std::runtime_error("command #" + std::to_string(command.sequence) +
-                             " not reported executed within " + std::to_string(timeout) + " s");
-  }
-  std::printf("command #%lld executed\n", static_cast<long long>(command.sequence));
-  print_status(last);
-  return 0;
+  print_status(commander.status());
+  throw std::runtime_error(r.reason);
 }
 
 int status(sg::Bus& bus, bool follow, double timeout) {
@@ -137,11 +133,16 @@ int main(int argc, char** argv) {
   sg::auth::KeyOptions key_options;
   sg::auth::add_key_options(app, key_options);
   double speed = 0.5, timeout = 10;
-  bool wait_idle = false, degrees = false, follow = false;
+  bool wait_idle = false, degrees = false, follow = false, take_over = false;
   std::vector<double> xyz, rpy, joints;
   app.add_option("--speed", speed, "fraction of the joint speed limits, (0, 1] (default 0.5)");
-  app.add_option("--timeout", timeout, "seconds to wait for the driver (default 10)");
-  app.add_flag("--wait", wait_idle, "wait until the arm is at rest");
+  app.add_option("--timeout", timeout,
+                 "seconds to wait for the command to be executed and the arm at rest (default 10)");
+  app.add_flag("--wait", wait_idle,
+               "accepted for old scripts and ignored: every command now waits until the arm is "
+               "at rest");
+  app.add_flag("--take-over", take_over,
+               "take the commander lease even when another sender holds it (sg-grasp, say)");
   app.require_subcommand(1);
   auto* move = app.add_subcommand("move", "move the tool centre point to X Y Z (m)");
   move->add_option("X Y Z", xyz, "robot base frame, metres")->expected(3)->required();
@@ -183,9 +184,9 @@ int main(int argc, char** argv) {
     } else if (!*stop) {
       throw std::runtime_error("no command");
     }
+    c.take_over = take_over;
     return sg::auth::with_lab_access(app.get_name(), key_options, [&](sg::auth::LabAccess& lab) {
-      lab.sign("ARM_COMMAND", c);
-      return send(bus, c, wait_idle, timeout);
+      return send(bus, lab, c, timeout);
     });
   });
 }

@@ -5,7 +5,10 @@
 // back-off when the device vanishes. The same binary drives a real C550 or sg-c550-sim.
 // Every ARM_COMMAND must be signed with the lab key (docs/security.md): an unsigned, forged,
 // replayed or stale one is refused (ARM_STATUS: last_rejected_sequence, "unauthenticated: ...")
-// before it reaches the validator, so it cannot move the arm or lock its sender out.
+// before it reaches the validator, so it cannot move the arm or lock its sender out. One
+// commander at a time holds the lease (docs/arm.md): another sender's command is refused (counted
+// in PROCESS_STATUS, the log rate-limited), and when the holder's heartbeats stop for
+// arm_driver.commander_timeout the watchdog stops a moving arm (ABORT, the gripper kept).
 //
 //   sg-arm-driver --device /dev/ttyUSB0              # a real C550 at 38,400 8N1
 //   sg-arm-driver --device /tmp/c550                  # sg-c550-sim --link /tmp/c550
@@ -34,17 +37,20 @@ int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
   sg::Bus bus(url);
   bus.announce("sg-arm-driver");
   sg::arm::SerialPort::open(s.device, s.serial).reset();  // fail now, clearly, on a bad path
-  sg::arm::ArmDriver driver(geometry, s.driver, [&] {
+  sg::arm::DriverSettings settings = s.driver;
+  settings.start_utime = sg::now_utime();  // ARM_STATUS.driver_start_utime: a restart shows
+  sg::arm::ArmDriver driver(geometry, settings, [&] {
     return std::unique_ptr<sg::arm::ByteStream>(sg::arm::SerialPort::open(s.device, s.serial));
   });
   bus.subscribe<stereograsp::arm_cmd_t>(
       "ARM_COMMAND",
       [&](const stereograsp::arm_cmd_t& command, const sg::ReceiveInfo& info) {
         const std::string why = lab.refusal(info.channel, command, sg::now_utime());
-        if (why.empty()) {
-          driver.submit(command);
-        } else {
+        if (!why.empty()) {
           driver.refuse(command, why);
+          bus.note_refused(info.channel, why);  // counted, and logged rate-limited
+        } else if (const auto r = driver.submit(command); r.outcome == r.kRefused) {
+          bus.note_refused(info.channel, "from '" + command.sender + "': " + r.reason);
         }
       });
   spdlog::info("driving the C550 on {} at {}", s.device, sg::arm::describe(s.serial));
@@ -78,6 +84,7 @@ int main(int argc, char** argv) {
   common.flags.add(app, "--framing", "arm_driver.framing", keys);
   common.flags.add(app, "--slave", "arm_driver.slave", keys);
   common.flags.add(app, "--status-rate", "arm_driver.status_rate_hz", keys);
+  common.flags.add(app, "--commander-timeout", "arm_driver.commander_timeout", keys);
   return sg::run_program(app, argc, argv, [&] {
     const sg::Config config = sg::load_common(common);
     const sg::arm::ArmDriverSettings settings = sg::arm::read_arm_driver_settings(config);

@@ -57,8 +57,7 @@ TEST(CommanderLease, TakeOverTakesTheLease) {
   EXPECT_EQ(d.taken_from, kGrasp);
   EXPECT_TRUE(d.changed);
   EXPECT_EQ(lease.holder(), kCtl);
-  EXPECT_EQ(lease.offer(kGrasp, Cmd::MODE_CARTESIAN, false, 10.6).verdict,
-            LeaseVerdict::kRefused);
+  EXPECT_EQ(lease.offer(kGrasp, Cmd::MODE_CARTESIAN, false, 10.6).verdict, LeaseVerdict::kRefused);
 }
 
 // A holder silent for the timeout loses the lease to the next sender, without take_over.
@@ -121,11 +120,9 @@ TEST(CommanderLease, ReleaseOnlyByTheHolder) {
 // and does not refresh the holder.
 TEST(CommanderLease, HeartbeatsRenewOnlyTheHolder) {
   CommanderLease lease(1.6);
-  EXPECT_EQ(lease.offer(kGrasp, Cmd::MODE_HEARTBEAT, false, 10.0).verdict,
-            LeaseVerdict::kRenewed);
+  EXPECT_EQ(lease.offer(kGrasp, Cmd::MODE_HEARTBEAT, false, 10.0).verdict, LeaseVerdict::kRenewed);
   EXPECT_EQ(lease.holder(), kGrasp);
-  EXPECT_EQ(lease.offer(kGrasp, Cmd::MODE_HEARTBEAT, false, 11.0).verdict,
-            LeaseVerdict::kRenewed);
+  EXPECT_EQ(lease.offer(kGrasp, Cmd::MODE_HEARTBEAT, false, 11.0).verdict, LeaseVerdict::kRenewed);
   EXPECT_DOUBLE_EQ(lease.deadline(), 12.6);
   EXPECT_EQ(lease.offer(kCtl, Cmd::MODE_HEARTBEAT, false, 12.0).verdict, LeaseVerdict::kRefused);
   EXPECT_DOUBLE_EQ(lease.deadline(), 12.6);

@@ -58,7 +58,8 @@ struct Rig {
         controller(ArmGeometry::a465()),
         emulator(controller),
         line(emulator, clock),
-        driver(ArmGeometry::a465(), DriverSettings{}, [this] { return line.connect(); }, clock) {
+        driver(
+            ArmGeometry::a465(), DriverSettings{}, [this] { return line.connect(); }, clock) {
     // Samples the emulator's log every 10 ms: when each line first appeared.
     clock.every(0.01, [this](double t) {
       const auto lines = emulator.executed_commands();
@@ -75,7 +76,8 @@ struct Rig {
   }
   /// From `from` to `to`, a heartbeat of `sender` (sequence `sequence`) every 0.2 s.
   void heartbeats(const std::string& sender, int64_t sequence, double from, double to) {
-    for (double t = from; t <= to + 1e-9; t += 0.2) at(t, bare(sender, Cmd::MODE_HEARTBEAT, sequence));
+    for (double t = from; t <= to + 1e-9; t += 0.2)
+      at(t, bare(sender, Cmd::MODE_HEARTBEAT, sequence));
   }
   /// At `t`, keeps a copy of the status in `snapshots`.
   void snapshot(double t) {
@@ -311,10 +313,12 @@ TEST(Duplicates, TheSameSequenceIsExecutedOnce) {
 TEST(CommanderLeaseInDriver, ReportsTheDriverStartTime) {
   system::SimulatedClock clock(1'700'000'000'000'000);
   DriverSettings settings;
-  ArmDriver implicit(ArmGeometry::a465(), settings, [] { return nullptr; }, clock);
+  ArmDriver implicit(
+      ArmGeometry::a465(), settings, [] { return nullptr; }, clock);
   EXPECT_EQ(implicit.status().first.driver_start_utime, 1'700'000'000'000'000);
   settings.start_utime = 42;
-  ArmDriver given(ArmGeometry::a465(), settings, [] { return nullptr; }, clock);
+  ArmDriver given(
+      ArmGeometry::a465(), settings, [] { return nullptr; }, clock);
   EXPECT_EQ(given.status().first.driver_start_utime, 42);
 }
 

@@ -84,6 +84,7 @@ TEST(DriverAuth, RefusesUnsignedAndForgedExecutesSigned) {
                          "the unsigned command refused"));
   EXPECT_EQ(status.rejection_reason, "unauthenticated: unsigned command from 'rogue' (no auth_tag)");
   EXPECT_EQ(status.last_received_sequence, -1);
+  EXPECT_EQ(status.commander, "");  // an unauthenticated command takes no lease
 
   // Forged: issue 15's STOP that locked sg-grasp out, with a random tag.
   arm_cmd_t forged{};
@@ -123,6 +124,7 @@ TEST(DriverAuth, RefusesUnsignedAndForgedExecutesSigned) {
                        status.tool_position[2] - 0.30),
             1e-3);
   EXPECT_EQ(moves_logged(log), 1);
+  EXPECT_EQ(status.commander, "sg-grasp");  // the signed sender holds the lease
 
   // The same signed bytes again: a replay, refused before the validator.
   bus.publish("ARM_COMMAND", real);

@@ -1,12 +1,16 @@
 // sg-arm-driver and sg-c550-sim as processes on a real pseudo-terminal, over real LCM: a move, a
-// gripper cycle, a rejected target, latest-wins under a burst, recovery after a disconnect, and
-// sg-arm-ctl at the bench. The test's commands are signed with the lab key in $SG_LAB_KEY (ctest
-// gives it; docs/security.md).
+// gripper cycle, a rejected target, latest-wins under a burst, recovery after a disconnect,
+// sg-arm-ctl at the bench, the commander lease (sg-arm-ctl refused while another sender holds it,
+// obeyed with --take-over) and the watchdog (a silent commander's long move gets ABORT). The
+// test's commands are signed with the lab key in $SG_LAB_KEY (ctest gives it;
+// docs/security.md); while the rig waits it sends a heartbeat every 0.2 s, as a live commander
+// does, unless told to fall silent.
 
 #include <gtest/gtest.h>
 #include <signal.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <sstream>
@@ -126,18 +130,35 @@ class ArmRig {
   Bus& bus() { return bus_; }
   /// Signs `c` with the lab key ($SG_LAB_KEY, as the driver reads it) and publishes it.
   void command(arm_cmd_t c) {
+    if (c.mode != arm_cmd_t::MODE_HEARTBEAT) last_sequence_ = c.sequence;
     signer_.sign("ARM_COMMAND", c);
     bus_.publish("ARM_COMMAND", c);
+    last_sent_ = std::chrono::steady_clock::now();
   }
+  /// From now on wait_until() sends no heartbeats: the commander has gone silent.
+  void fall_silent() { silent_ = true; }
   const arm_status_t& status() const { return status_; }
   const sim_arm_state_t& truth() const { return truth_; }
   bool saw_disconnected() const { return saw_disconnected_; }
 
-  /// Handles messages until `done()` holds or `timeout` passes; returns done().
-  bool wait_until(const std::function<bool()>& done, std::chrono::seconds timeout) {
+  /// Handles messages until `done()` holds or `timeout` passes, with a heartbeat every 0.2 s
+  /// after the first command (unless silent); returns done().
+  bool wait_until(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
     const auto deadline = std::chrono::steady_clock::now() + timeout;
-    while (!done() && std::chrono::steady_clock::now() < deadline) bus_.handle(20ms);
+    while (!done() && std::chrono::steady_clock::now() < deadline) {
+      bus_.handle(20ms);
+      if (!silent_ && last_sequence_ >= 0 && std::chrono::steady_clock::now() - last_sent_ >= 200ms)
+        command(heartbeat(last_sequence_));
+    }
     return done();
+  }
+  /// A heartbeat carrying the sender's last sequence.
+  static arm_cmd_t heartbeat(int64_t sequence) {
+    arm_cmd_t c{};
+    c.utime = now_utime();
+    c.sequence = sequence;
+    c.mode = arm_cmd_t::MODE_HEARTBEAT;
+    return c;
   }
 
   /// Waits for the driver's first status with the controller connected.
@@ -168,6 +189,9 @@ class ArmRig {
   sim_arm_state_t truth_{};
   int status_count_ = 0;
   bool saw_disconnected_ = false;
+  int64_t last_sequence_ = -1;  ///< of the last command: heartbeats repeat it
+  std::chrono::steady_clock::time_point last_sent_{};
+  bool silent_ = false;
 };
 
 /// Distance from the status's tool centre point to (x, y, z).
@@ -249,7 +273,7 @@ TEST(ArmProcesses, RecoversAfterADisconnect) {
     ++sequence;
     const double a = 0.2 * static_cast<double>(sequence);
     rig.command(move_to(sequence, 0.50 * std::cos(a), 0.50 * std::sin(a), 0.35));
-    handle_for(rig.bus(), 1s);  // pacing: one command a second, across the line's outage
+    rig.wait_until([] { return false; }, 1s);  // pacing: one a second, across the line's outage
   }
   ASSERT_TRUE(rig.wait_executed(sequence, 30s)) << rig.status().error;
   EXPECT_TRUE(rig.saw_disconnected());
@@ -278,6 +302,95 @@ TEST(ArmProcesses, ArmCtlMovesTheArm) {
   EXPECT_NE(refused.exit_code, 0);
   EXPECT_NE((refused.out + refused.err).find("rejected"), std::string::npos)
       << refused.out << refused.err;
+}
+
+/// Another commander: from its own thread and bus, a move and then a heartbeat every 0.2 s,
+/// signed as `name`, until it goes.
+class OtherCommander {
+ public:
+  OtherCommander(const std::string& url, const std::string& name)
+      : thread_([url, name](std::stop_token stop) {
+          Bus bus(url);
+          auth::CommandSigner signer(auth::LabKey::load(auth::default_key_path()), name);
+          arm_cmd_t c = move_to(1, 0.40, 0.0, 0.35);
+          while (!stop.stop_requested()) {
+            signer.sign("ARM_COMMAND", c);
+            bus.publish("ARM_COMMAND", c);
+            std::this_thread::sleep_for(200ms);  // the heartbeat period
+            c = ArmRig::heartbeat(1);
+          }
+        }) {}
+
+ private:
+  std::jthread thread_;
+};
+
+// While another sender holds the lease, `sg-arm-ctl move` is refused with the holder named and
+// exits 1, the arm unmoved; with --take-over it is obeyed, and the arm arrives.
+TEST(ArmProcesses, ArmCtlHonoursTheLeaseAndTakesItOver) {
+  ASSERT_TRUE(multicast_available(7927));
+  ArmRig rig(7927, {});
+  ASSERT_TRUE(rig.wait_connected());
+  OtherCommander holder(rig.url(), "holder@bench:1");
+  ASSERT_TRUE(rig.wait_until([&] { return rig.status().commander == "holder@bench:1"; }, 10s))
+      << "commander '" << rig.status().commander << "'";
+  ASSERT_TRUE(rig.wait_until([&] { return rig.status().state == arm_status_t::STATE_IDLE; }, 10s));
+
+  const ProcessResult refused =
+      run({program("sg-arm-ctl"), "--lcm-url", rig.url(), "move", "0.5", "0.1", "0.3"}, 30s);
+  EXPECT_EQ(refused.exit_code, 1) << refused.out << refused.err;
+  EXPECT_NE(refused.out.find("rejected: arm commanded by 'holder@bench:1' (heard "),
+            std::string::npos)
+      << refused.out << refused.err;
+  EXPECT_NE(refused.out.find("sg-arm-ctl --take-over takes it"), std::string::npos) << refused.out;
+  EXPECT_EQ(rig.status().commander, "holder@bench:1");
+  EXPECT_GT(tool_error(rig.status(), 0.5, 0.1, 0.3), 0.05);  // not moved there
+
+  const ProcessResult taken = run({program("sg-arm-ctl"), "--lcm-url", rig.url(), "--take-over",
+                                   "move", "0.5", "0.1", "0.3"},
+                                  30s);
+  EXPECT_EQ(taken.exit_code, 0) << taken.out << taken.err;
+  EXPECT_NE(taken.out.find("executed"), std::string::npos) << taken.out;
+  EXPECT_TRUE(rig.wait_until([&] { return tool_error(rig.status(), 0.5, 0.1, 0.3) < 1e-3; }, 10s));
+}
+
+// The watchdog: a signed long, slow move, then silence. The emulator logs ABORT no sooner than
+// the commander timeout (1.6 s) after the command and no later than the timeout plus one
+// interaction (sg-c550-sim here: at most 0.4 s), with 0.3 s allowed for delivery and scheduling
+// on a loaded machine; the gripper is not touched, the arm stops short of the target, and
+// ARM_STATUS says why.
+TEST(ArmProcesses, WatchdogAbortsASilentCommandersMove) {
+  ASSERT_TRUE(multicast_available(7928));
+  ArmRig rig(7928, {});
+  ASSERT_TRUE(rig.wait_connected());
+  rig.fall_silent();
+  arm_cmd_t slow = move_to(1, 0.40, -0.30, 0.20);
+  slow.speed = 0.03;
+  const int64_t sent = now_utime();
+  rig.command(slow);
+  ASSERT_TRUE(rig.wait_until([&] { return !rig.status().watchdog.empty(); }, 10s))
+      << rig.status().error;
+  EXPECT_EQ(rig.status().watchdog.rfind("stopped: 'arm_test' silent for 1.", 0), 0u)
+      << rig.status().watchdog;
+  EXPECT_EQ(rig.status().commander, "");
+  ASSERT_TRUE(rig.wait_until(
+      [&] { return !starting_with(logged_commands(rig.command_log()), "ABORT").empty(); }, 5s));
+  int64_t abort_utime = 0;
+  std::istringstream log(read_text(rig.command_log()));
+  for (std::string line; std::getline(log, line);) {
+    if (line.find("\tABORT") != std::string::npos) abort_utime = std::stoll(line);
+  }
+  const double after = static_cast<double>(abort_utime - sent) * 1e-6;
+  std::printf("ABORT logged %.2f s after the command\n", after);
+  EXPECT_GE(after, 1.6);
+  EXPECT_LE(after, 1.6 + 0.4 + 0.3);
+  const auto commands = logged_commands(rig.command_log());
+  EXPECT_EQ(starting_with(commands, "ABORT").size(), 1u);
+  EXPECT_TRUE(starting_with(commands, "OPEN").empty());
+  EXPECT_TRUE(starting_with(commands, "CLOSE").empty());
+  ASSERT_TRUE(rig.wait_until([&] { return rig.status().state == arm_status_t::STATE_IDLE; }, 5s));
+  EXPECT_GT(tool_error(rig.status(), 0.40, -0.30, 0.20), 0.02) << "stopped short of the target";
+  EXPECT_EQ(rig.status().last_executed_sequence, 1);
 }
 
 }  // namespace
