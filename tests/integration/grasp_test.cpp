@@ -2,6 +2,8 @@
 // pseudo-terminal: sg-camera-sim films the ball, sg-vision triangulates it, sg-predictor forecasts
 // it (from offline-trained coefficients), sg-grasp tracks and grasps it through sg-arm-driver and
 // sg-c550-sim; sg-grasp-ctl asks for the grasp and the simulator's truth says the ball is held.
+// And a kill -9 of sg-grasp mid-tracking: the driver's watchdog frees the arm (stopping it if it
+// moves), and a restarted sg-grasp sends nothing until an operator commands it.
 
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -10,6 +12,8 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "common/bus.hpp"
 #include "common/clock.hpp"
@@ -168,6 +172,149 @@ TEST(GraspLoop, TracksGraspsAndLiftsTheBall) {
   EXPECT_EQ(status->outcome, stereograsp::grasp_status_t::OUTCOME_SUCCESS) << grasped.out;
   EXPECT_EQ(status->command_result, stereograsp::grasp_status_t::RESULT_ACCEPTED) << grasped.out;
   EXPECT_TRUE(held) << "SIM_ARM_STATE does not show the ball held\n" << logs;
+}
+
+/// The paper's circle as sg-predictor would forecast it at `now`: 16 points at 4 Hz from
+/// now + 0.25 s, the ball tracked.
+stereograsp::trajectory_t circle_forecast(int64_t now) {
+  stereograsp::trajectory_t m{};
+  m.utime = now;
+  m.source_utime = now - 50'000;
+  m.period_us = 250'000;
+  m.start_utime = now + m.period_us;
+  m.num_points = 16;
+  for (int i = 0; i < 16; ++i) {
+    const double t = 1e-6 * static_cast<double>(m.start_utime + i * m.period_us);
+    const double a = 2 * M_PI * t / 60.0;
+    m.position.push_back({0.45 + 0.15 * std::cos(a), 0.15 * std::sin(a), 0.10});
+  }
+  m.status = stereograsp::trajectory_t::STATUS_TRACKING;
+  return m;
+}
+
+/// Every ARM_COMMAND on a bus, with its sender.
+struct CommandWatch {
+  explicit CommandWatch(Bus& bus) {
+    bus.subscribe<stereograsp::arm_cmd_t>(
+        "ARM_COMMAND", [this](const auto& m, const auto&) { commands.push_back(m); });
+  }
+  /// How many came from the sg-grasp of process `pid` ("sg-grasp@<host>:<pid>").
+  int from(pid_t pid) const {
+    int n = 0;
+    for (const auto& c : commands) n += sender_is(c.sender, pid);
+    return n;
+  }
+  static bool sender_is(const std::string& sender, pid_t pid) {
+    const std::string tail = ":" + std::to_string(pid);
+    return sender.rfind("sg-grasp@", 0) == 0 && sender.size() > tail.size() &&
+           sender.compare(sender.size() - tail.size(), tail.size(), tail) == 0;
+  }
+  std::vector<stereograsp::arm_cmd_t> commands;
+};
+
+// kill -9 of sg-grasp while it tracks (the forecasts come from the test at 4 Hz): its heartbeats
+// stop, the driver's lease expires and the arm comes to rest (the watchdog stops it if it still
+// moves); a restarted sg-grasp, with the same forecasts coming, sends no ARM_COMMAND at all for
+// 3 s and the arm does not move, until sg-grasp-ctl track, which it then obeys.
+TEST(GraspLoop, RestartedAfterKillNineSendsNothingUntilCommanded) {
+  ASSERT_TRUE(multicast_available(7925));
+  const std::string url = test_url(7925);
+  const std::string dir = make_temp_dir();
+  Bus bus(url);
+  Watch watch(bus);
+  CommandWatch sent(bus);
+  std::optional<stereograsp::grasp_status_t> status;
+  bus.subscribe<stereograsp::grasp_status_t>("GRASP_STATUS",
+                                             [&](const auto& s, const auto&) { status = s; });
+  int64_t fed = 0;
+  const auto feed = [&] {  // a forecast every 250 ms, from the conditions waited on
+    if (now_utime() - fed < 250'000) return;
+    fed = now_utime();
+    bus.publish("OBJECT_TRAJECTORY", circle_forecast(fed));
+  };
+
+  Child c550(
+      {program("sg-c550-sim"), "--lcm-url", url, "--link", dir + "/c550", "--log-level", "warn"});
+  ASSERT_TRUE(eventually([&] { return std::filesystem::exists(dir + "/c550"); }, 30s,
+                         "sg-c550-sim's pseudo-terminal"));
+  Child driver({program("sg-arm-driver"), "--lcm-url", url, "--device", dir + "/c550"});
+  auto first =
+      std::make_optional<Child>(std::vector<std::string>{program("sg-grasp"), "--lcm-url", url});
+  const pid_t first_pid = first->pid();
+  ASSERT_TRUE(eventually(
+      bus, [&] { return joined_bus(first_pid, 7925) && watch.arm_idle(); }, 60s,
+      "sg-grasp to join the bus and the arm at rest"));
+  const ProcessResult track = run({program("sg-grasp-ctl"), "--lcm-url", url, "track"}, 20s);
+  ASSERT_EQ(track.exit_code, 0) << track.out << track.err;
+  ASSERT_TRUE(eventually(
+      bus,
+      [&] {
+        feed();
+        return CommandWatch::sender_is(watch.arm.commander, first_pid) &&
+               watch.arm.state == stereograsp::arm_status_t::STATE_MOVING &&
+               sent.from(first_pid) >= 10;  // tracking for a while, heartbeats and moves
+      },
+      60s, "the arm to track the ball for the first sg-grasp"));
+
+  first->signal(SIGKILL);
+  EXPECT_EQ(first->wait(10s).exit_code, 128 + SIGKILL);
+  first.reset();
+  const int64_t killed = now_utime();
+  // The lease expires after arm_driver.commander_timeout (1.6 s) of silence; a moving arm is
+  // stopped then, within a controller interaction (0.84 s).
+  ASSERT_TRUE(eventually(
+      bus,
+      [&] {
+        feed();
+        return watch.arm.utime > killed + 1'600'000 && watch.arm.commander.empty() &&
+               watch.arm.state == stereograsp::arm_status_t::STATE_IDLE;
+      },
+      10s, "the lease to expire and the arm to rest"))
+      << "commander '" << watch.arm.commander << "', watchdog '" << watch.arm.watchdog << "'";
+  EXPECT_LT(watch.arm.utime - killed, 1'600'000 + 840'000 + 1'000'000);  // + 1 s for the load
+  if (!watch.arm.watchdog.empty()) {
+    EXPECT_NE(watch.arm.watchdog.find("silent for"), std::string::npos) << watch.arm.watchdog;
+  }
+
+  const stereograsp::arm_status_t rest = watch.arm;
+  const std::size_t before = sent.commands.size();
+  Child second({program("sg-grasp"), "--lcm-url", url});
+  const int64_t restarted = now_utime();
+  ASSERT_TRUE(eventually(
+      bus,
+      [&] {
+        feed();
+        return joined_bus(second.pid(), 7925) && status && status->utime > restarted;
+      },
+      30s, "the restarted sg-grasp's GRASP_STATUS"));
+  const int64_t watching = now_utime();
+  wait_until(
+      bus,
+      [&] {
+        feed();
+        return now_utime() > watching + 3'000'000;
+      },
+      10s);
+  EXPECT_EQ(sent.commands.size(), before) << "the restarted sg-grasp sent ARM_COMMAND unasked";
+  EXPECT_EQ(watch.arm.last_executed_sequence, rest.last_executed_sequence);
+  for (int i = 0; i < 6; ++i) EXPECT_NEAR(watch.arm.joints[i], rest.joints[i], 1e-6) << i;
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(status->activity, stereograsp::grasp_status_t::ACTIVITY_IDLE);
+  EXPECT_EQ(status->state, stereograsp::grasp_status_t::Q0_HAND_OPENED);
+
+  const ProcessResult again = run({program("sg-grasp-ctl"), "--lcm-url", url, "track"}, 20s);
+  EXPECT_EQ(again.exit_code, 0) << again.out << again.err;
+  EXPECT_TRUE(eventually(
+      bus,
+      [&] {
+        feed();
+        return CommandWatch::sender_is(watch.arm.commander, second.pid()) &&
+               sent.from(second.pid()) > 0;
+      },
+      30s, "the restarted sg-grasp to command the arm once asked"));
+  stop(second);
+  stop(driver);
+  stop(c550);
 }
 
 }  // namespace
