@@ -237,6 +237,7 @@ void GraspMachine::on_measurement(const std::optional<Eigen::Vector3d>& position
 
 void GraspMachine::on_arm_status(const ArmView& arm, int64_t now) {
   const bool restarted = have_arm_ && arm.driver_start_utime != arm_.driver_start_utime;
+  const bool watchdog = have_arm_ && !arm.watchdog.empty() && arm.watchdog != arm_.watchdog;
   if (!have_arm_) start_from(arm);
   arm_ = arm;
   have_arm_ = true;
@@ -270,6 +271,9 @@ void GraspMachine::on_arm_status(const ArmView& arm, int64_t now) {
       answered(false, "", now);
     }
   }
+  // The watchdog's STOP replaced a request the driver held: it will not be executed.
+  if (watchdog && in_flight_)
+    answered(true, "the driver's watchdog stopped the arm: abandoned ", now);
   if (judging_ && !stopped_utime_ && !in_flight_ && !arm.moving) stopped_utime_ = now;
   update(now);
 }

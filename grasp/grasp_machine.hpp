@@ -32,7 +32,8 @@
 /// the copy anew), counted in resends(). When ARM_STATUS's driver_start_utime changes with a
 /// request in flight (the driver restarted; the old one may have executed it), the request is
 /// not resent: it is abandoned as failed ("driver restarted") and the next one is computed afresh
-/// under a new sequence. A request with no answer for kAnswerTimeout (or 8 delays, whichever is
+/// under a new sequence. So is one in flight when ARM_STATUS shows a new watchdog stop (the
+/// driver's STOP replaced the command it held). A request with no answer for kAnswerTimeout (or 8 delays, whichever is
 /// longer) since it was first sent is given up and treated as failed.
 ///
 /// Rejections are backed off. After the k-th consecutive rejection (reset when a request is
@@ -234,6 +235,7 @@ struct ArmView {
   int64_t last_rejected_sequence = -1;
   std::string rejection_reason;    ///< why last_rejected_sequence was rejected
   int64_t driver_start_utime = 0;  ///< changes when the driver restarts
+  std::string watchdog;  ///< the driver watchdog's last stop ("" when none): a change is a stop
   Joints joints = Joints::Zero();
   Eigen::Vector3d tool = Eigen::Vector3d::Zero();  ///< tool centre point
   double interaction_time = 0;                     ///< s, of the driver's last interaction

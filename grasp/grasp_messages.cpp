@@ -31,6 +31,7 @@ ArmView arm_view_of(const stereograsp::arm_status_t& s) {
   v.last_rejected_sequence = s.last_rejected_sequence;
   v.rejection_reason = s.rejection_reason;
   v.driver_start_utime = s.driver_start_utime;
+  v.watchdog = s.watchdog;
   for (int i = 0; i < 6; ++i) v.joints[i] = s.joints[i];
   v.tool = {s.tool_position[0], s.tool_position[1], s.tool_position[2]};
   v.interaction_time = s.interaction_time;

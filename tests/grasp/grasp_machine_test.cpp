@@ -1087,6 +1087,29 @@ TEST(GraspMachineTest, NoResendAcrossADriverRestart) {
   EXPECT_EQ(rig.machine.consecutive_rejections(), 0);
 }
 
+// A new watchdog stop on ARM_STATUS with a request in flight (the driver's STOP replaced it):
+// the request is abandoned and, the track fresh, the next one computed at once; the same
+// watchdog text again changes nothing.
+TEST(GraspMachineTest, WatchdogStopAbandonsTheRequestInFlight) {
+  Rig rig;
+  reach(rig, At::kQ0Tracking);
+  const std::optional<ArmRequest> first = rig.take();
+  ASSERT_EQ(kind(first), Req::kMove) << rig.status().message;
+  rig.advance(0.3);
+  rig.arm.watchdog = "stopped: 'sg-grasp@lab1:412' silent for 1.62 s";
+  rig.feed();
+  rig.publish();
+  EXPECT_EQ(rig.status().message,
+            "the driver's watchdog stopped the arm: abandoned the tracking target (request " +
+                std::to_string(first->sequence) + ")");
+  const std::optional<ArmRequest> next = rig.take();
+  ASSERT_EQ(kind(next), Req::kMove);
+  EXPECT_EQ(next->sequence, first->sequence + 1);
+  rig.advance(0.3);
+  rig.publish();  // the same watchdog text: nothing abandoned
+  EXPECT_FALSE(rig.take().has_value());
+}
+
 // No ARM_STATUS for more than arm_status_timeout (1 s): no request and no heartbeat (arm_need
 // silent), the silence reported; when statuses return, requests resume. An abort's STOP goes
 // out regardless.

@@ -63,11 +63,13 @@ TEST(GraspMessages, ArmStatusToView) {
   s.last_received_sequence = 4;
   s.rejection_reason = "arm commanded by 'x'";
   s.driver_start_utime = 1'790'000'000'000'000;
+  s.watchdog = "stopped: 'a' silent for 1.62 s";
   ArmView v = arm_view_of(s);
   EXPECT_EQ(v.gripper, arm_status_t::GRIPPER_CLOSED);
   EXPECT_EQ(v.last_received_sequence, 4);
   EXPECT_EQ(v.rejection_reason, "arm commanded by 'x'");
   EXPECT_EQ(v.driver_start_utime, 1'790'000'000'000'000);
+  EXPECT_EQ(v.watchdog, "stopped: 'a' silent for 1.62 s");
   EXPECT_TRUE(v.connected);
   EXPECT_TRUE(v.moving);
   EXPECT_FALSE(v.error);
