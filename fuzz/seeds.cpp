@@ -20,6 +20,7 @@
 #include "arm_driver/kinematics.hpp"
 #include "arm_driver/rapl.hpp"
 #include "common/bus_check.hpp"
+#include "fuzz/signed_commands.hpp"
 #include "predictor/offline_training.hpp"
 #include "sim/c550_controller.hpp"
 #include "sim/c550_emulator.hpp"
@@ -178,6 +179,28 @@ void coefficients(const fs::path& out) {
   std::printf("%s\n", (out / "config" / "coefficients.yaml").c_str());
 }
 
+/// mac_check: a signed ARM_COMMAND, a signed GRASP_COMMAND, the first unsigned and signed with
+/// another key, a signed one on another channel, a replay, and the two ARM_COMMANDs in order.
+void signed_commands(const fs::path& out) {
+  namespace fz = sg::fuzz;
+  const std::vector<fz::SignedCommand> good = fz::signed_commands();
+  const std::vector<fz::SignedCommand> bad = fz::unsigned_and_wrong_key();
+  const auto records = [](std::vector<fz::SignedCommand> commands) {
+    Bytes input;
+    for (const fz::SignedCommand& c : commands) fz::append_record(input, c);
+    return input;
+  };
+  fz::SignedCommand elsewhere = good[0];
+  elsewhere.channel = 2;
+  save(out / "mac_check/signed_arm", records({good[0]}));
+  save(out / "mac_check/signed_grasp", records({good[2]}));
+  save(out / "mac_check/unsigned_arm", records({bad[0]}));
+  save(out / "mac_check/other_key_arm", records({bad[1]}));
+  save(out / "mac_check/other_channel_arm", records({elsewhere}));
+  save(out / "mac_check/replayed_arm", records({good[0], good[0]}));
+  save(out / "mac_check/two_arm_in_order", records({good[0], good[1], good[2]}));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -190,5 +213,6 @@ int main(int argc, char** argv) {
   aci_frames(out);
   logs(out);
   coefficients(out);
+  signed_commands(out);
   return 0;
 }
