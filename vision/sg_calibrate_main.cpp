@@ -22,6 +22,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "arm_driver/arm_commander.hpp"
 #include "auth/lab_access.hpp"
 #include "common/bus.hpp"
 #include "common/clock.hpp"
@@ -229,6 +230,7 @@ int run_robot(const std::string& url, const sg::vision::RobotCalibrationParams& 
   // Sequence numbers from the clock, so they are newer than any the driver has seen.
   sg::vision::RobotCalibration cal(params, sg::now_utime());
   ArmWatch arm;
+  sg::arm::ArmCommander commander(bus, lab);  // signs; the lease released at the end
   bus.subscribe<stereograsp::arm_status_t>(
       "ARM_STATUS", [&](const auto& status, const auto&) { arm.on_status(status, cal); });
   bus.subscribe<stereograsp::blob_t>("BLOB_(LEFT|RIGHT)", [&](const auto& b, const auto&) {
@@ -246,11 +248,8 @@ int run_robot(const std::string& url, const sg::vision::RobotCalibrationParams& 
                                  " s (is sg-arm-driver running?); nothing written");
       return true;
     }
-    if (auto t = cal.next_target()) {
-      stereograsp::arm_cmd_t command = command_to(*t, sg::now_utime());
-      lab.sign("ARM_COMMAND", command);
-      bus.publish("ARM_COMMAND", command);
-    }
+    if (auto t = cal.next_target()) commander.send(command_to(*t, sg::now_utime()));
+    commander.tick();  // heartbeats keep the lease while the arm moves and dwells
     const std::string progress = cal.progress();
     if (progress != last_progress) {
       spdlog::info("{}", progress);
@@ -264,6 +263,7 @@ int run_robot(const std::string& url, const sg::vision::RobotCalibrationParams& 
     }
     return !cal.done();
   });
+  commander.release();
   if (!cal.done())
     throw std::runtime_error("interrupted at " + cal.progress() + "; nothing written");
   const int skipped = warn_skipped(cal.stops());
