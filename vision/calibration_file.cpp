@@ -1,12 +1,17 @@
 #include "vision/calibration_file.hpp"
 
+#include <yaml-cpp/yaml.h>
+
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <opencv2/core.hpp>
 #include <opencv2/core/eigen.hpp>
+#include <sstream>
+#include <utility>
 
 namespace sg::vision {
 namespace {
@@ -38,56 +43,98 @@ void write_camera(cv::FileStorage& fs, const std::string& name, const CameraMode
   fs << "}";
 }
 
-/// Reads a rows x cols matrix of doubles at `node`, or throws naming `key`.
-cv::Mat read_matrix(const cv::FileNode& node, const std::string& path, const std::string& key,
-                    int rows, int cols) {
-  if (node.empty()) throw CalibrationError(path + ": key '" + key + "' is missing");
-  const std::string shape = "must be a " + std::to_string(rows) + "x" + std::to_string(cols) +
-                            " matrix";
-  // The size it claims first: OpenCV allocates rows x cols before reading the data (a 40-byte
-  // claim of 10^5 x 10^5 asked for 48 GB in fuzz/calibration_fuzz).
-  if (!node["rows"].isInt() || !node["cols"].isInt() || static_cast<int>(node["rows"]) != rows ||
-      static_cast<int>(node["cols"]) != cols) {
-    throw CalibrationError(path + ": key '" + key + "' " + shape);
+/// Whether a key is there with a value (a missing key's node is not defined, and asking it for
+/// its type throws).
+bool present(const YAML::Node& node) { return node.IsDefined() && !node.IsNull(); }
+
+/// "FILE:LINE: key 'KEY' ": where an error is (the line of the node when it has one).
+std::string where(const std::string& path, const YAML::Node& node, const std::string& key) {
+  const YAML::Mark mark = node.IsDefined() ? node.Mark() : YAML::Mark::null_mark();
+  std::string out = path;  // appended piecewise: GCC 12's -Wrestrict misfires on a + chain here
+  if (!mark.is_null()) out.append(":").append(std::to_string(mark.line + 1));
+  return out.append(": key '").append(key).append("' ");
+}
+
+/// The scalar at `node` as T, or throws naming `key` and `what` it must be.
+template <class T>
+T scalar(const YAML::Node& node, const std::string& path, const std::string& key,
+         const std::string& what) {
+  if (!present(node)) throw CalibrationError(where(path, node, key) + "is missing");
+  T value{};
+  if (!node.IsScalar() || !YAML::convert<T>::decode(node, value))
+    throw CalibrationError(where(path, node, key) + "must be " + what);
+  return value;
+}
+
+/// Reads the rows x cols matrix of doubles at `node`, as FileStorage writes one
+/// (`!!opencv-matrix` {rows, cols, dt, data: [row-major values]}), or throws naming `key`.
+/// The size it claims is checked before anything else is read.
+Eigen::MatrixXd read_matrix(const YAML::Node& node, const std::string& path, const std::string& key,
+                            int rows, int cols) {
+  if (!present(node)) throw CalibrationError(where(path, node, key) + "is missing");
+  const std::string shape =
+      "must be a " + std::to_string(rows) + "x" + std::to_string(cols) + " matrix";
+  if (!node.IsMap()) throw CalibrationError(where(path, node, key) + shape);
+  const auto is = [&](const char* k, int expected) {
+    const YAML::Node n = node[k];
+    int value = 0;
+    return n.IsDefined() && n.IsScalar() && YAML::convert<int>::decode(n, value) &&
+           value == expected;
+  };
+  const YAML::Node data = node["data"];
+  if (!is("rows", rows) || !is("cols", cols) || !data.IsDefined() || !data.IsSequence() ||
+      data.size() != static_cast<std::size_t>(rows * cols)) {
+    throw CalibrationError(where(path, node, key) + shape);
   }
-  cv::Mat m;
-  try {
-    node >> m;
-  } catch (const cv::Exception&) {
-    m.release();
+  Eigen::MatrixXd m(rows, cols);
+  for (int i = 0; i < rows * cols; ++i) {
+    double v = 0;
+    if (!data[i].IsScalar() || !YAML::convert<double>::decode(data[i], v))
+      throw CalibrationError(where(path, node, key) + shape + " of numbers");
+    if (!std::isfinite(v)) throw CalibrationError(where(path, node, key) + "is not finite");
+    m(i / cols, i % cols) = v;
   }
-  if (m.empty() || m.rows != rows || m.cols != cols) {
-    throw CalibrationError(path + ": key '" + key + "' " + shape);
-  }
-  m.convertTo(m, CV_64F);
-  if (!cv::checkRange(m)) throw CalibrationError(path + ": key '" + key + "' is not finite");
   return m;
 }
 
-CameraModel read_camera(const cv::FileNode& node, const std::string& path, const std::string& name,
+CameraModel read_camera(const YAML::Node& node, const std::string& path, const std::string& name,
                         int width, int height, double* rms) {
-  if (node.empty()) throw CalibrationError(path + ": key '" + name + "' is missing");
-  const cv::Mat K = read_matrix(node["K"], path, name + ".K", 3, 3);
-  const cv::Mat D = read_matrix(node["distortion"], path, name + ".distortion", 1, 5);
-  const cv::Mat R = read_matrix(node["R"], path, name + ".R", 3, 3);
-  const cv::Mat t = read_matrix(node["t"], path, name + ".t", 3, 1);
-  Eigen::Matrix3d R_e;
-  Eigen::Vector3d t_e;
-  cv::cv2eigen(R, R_e);
-  cv::cv2eigen(t, t_e);
-  if (!(R_e.transpose() * R_e).isApprox(Eigen::Matrix3d::Identity(), 1e-6) ||
-      R_e.determinant() < 0) {
-    throw CalibrationError(path + ": key '" + name + ".R' is not a rotation");
-  }
-  *rms = node["rms"].empty() ? 0.0 : static_cast<double>(node["rms"]);
-  const Intrinsics in{K.at<double>(0, 0), K.at<double>(1, 1), K.at<double>(0, 2),
-                      K.at<double>(1, 2), K.at<double>(0, 1)};
-  const Distortion dist{D.at<double>(0), D.at<double>(1), D.at<double>(2), D.at<double>(3),
-                        D.at<double>(4)};
+  if (!present(node)) throw CalibrationError(where(path, node, name) + "is missing");
+  if (!node.IsMap()) throw CalibrationError(where(path, node, name) + "must be a map");
+  const Eigen::Matrix3d K = read_matrix(node["K"], path, name + ".K", 3, 3);
+  const Eigen::MatrixXd D = read_matrix(node["distortion"], path, name + ".distortion", 1, 5);
+  const Eigen::Matrix3d R = read_matrix(node["R"], path, name + ".R", 3, 3);
+  const Eigen::Vector3d t = read_matrix(node["t"], path, name + ".t", 3, 1);
+  if (!(R.transpose() * R).isApprox(Eigen::Matrix3d::Identity(), 1e-6) || R.determinant() < 0)
+    throw CalibrationError(where(path, node["R"], name + ".R") + "is not a rotation");
+  *rms = present(node["rms"]) ? scalar<double>(node["rms"], path, name + ".rms", "a number") : 0.0;
+  if (!std::isfinite(*rms))
+    throw CalibrationError(where(path, node["rms"], name + ".rms") + "is not finite");
+  const Intrinsics in{K(0, 0), K(1, 1), K(0, 2), K(1, 2), K(0, 1)};
+  const Distortion dist{D(0), D(1), D(2), D(3), D(4)};
   try {
-    return CameraModel(width, height, in, dist, R_e, t_e);
+    return CameraModel(width, height, in, dist, R, t);
   } catch (const std::invalid_argument& e) {
     throw CalibrationError(path + ": " + name + ": " + e.what());
+  }
+}
+
+/// The file as yaml-cpp reads it: write_calibration's first line, OpenCV's "%YAML:1.0" (not
+/// a YAML 1.x directive), becomes an empty line so the line numbers stay the file's.
+YAML::Node parse_file(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw CalibrationError(path + ": cannot open calibration file");
+  std::stringstream text;
+  text << file.rdbuf();
+  std::string yaml = text.str();
+  if (!yaml.starts_with("%YAML:1.0\n"))
+    throw CalibrationError(path + ": not a calibration file (it starts with %YAML:1.0)");
+  yaml.erase(0, yaml.find('\n'));
+  try {
+    return YAML::Load(yaml);
+  } catch (const YAML::Exception& e) {
+    throw CalibrationError(path + ":" + std::to_string(e.mark.line + 1) +
+                           ": not a valid calibration file (" + e.msg + ")");
   }
 }
 
@@ -122,40 +169,35 @@ void write_calibration(const std::string& path, const StereoCalibration& c) {
 }
 
 StereoCalibration read_calibration(const std::string& path) {
-  // Only YAML as write_calibration writes it reaches FileStorage: OpenCV 4.6's XML parser
-  // dereferences NULL on some malformed files (fuzz/calibration_fuzz.cpp found a 43-byte one).
-  std::ifstream file(path, std::ios::binary);
-  if (!file) throw CalibrationError(path + ": cannot open calibration file");
-  std::string head(5, '\0');
-  if (!file.read(head.data(), 5) || head != "%YAML") {
-    throw CalibrationError(path + ": not a calibration file (it starts with %YAML:1.0)");
-  }
-  cv::FileStorage fs;
+  // Read with yaml-cpp, not FileStorage: OpenCV 4.6's parsers dereference NULL on some
+  // malformed XML and loop for ever on some truncated YAML (fuzz/calibration_fuzz found both).
+  const YAML::Node root = parse_file(path);
+  if (!root.IsMap()) throw CalibrationError(path + ": not a calibration file (not a map)");
   try {
-    if (!fs.open(path, cv::FileStorage::READ))
-      throw CalibrationError(path + ": cannot open calibration file");
-  } catch (const cv::Exception& e) {
-    throw CalibrationError(path + ": not a valid calibration file (" + e.err + ")");
+    const int version = scalar<int>(root["format_version"], path, "format_version", "an integer");
+    if (version != kCalibrationFormatVersion) {
+      throw CalibrationError(path + ": format_version " + std::to_string(version) +
+                             " is not supported (expected " +
+                             std::to_string(kCalibrationFormatVersion) + ")");
+    }
+    const int width = scalar<int>(root["image_width"], path, "image_width", "a positive integer");
+    const int height =
+        scalar<int>(root["image_height"], path, "image_height", "a positive integer");
+    if (width <= 0 || height <= 0) {
+      throw CalibrationError(path + ": key '" + (width <= 0 ? "image_width" : "image_height") +
+                             "' must be a positive integer");
+    }
+    StereoCalibration c;
+    c.left = read_camera(root["camera_left"], path, "camera_left", width, height, &c.rms_left);
+    c.right = read_camera(root["camera_right"], path, "camera_right", width, height, &c.rms_right);
+    for (auto [key, out] : {std::pair{"source", &c.source}, {"date", &c.date}}) {
+      if (present(root[key])) *out = scalar<std::string>(root[key], path, key, "a string");
+    }
+    return c;
+  } catch (const YAML::Exception& e) {  // e.g. a node used as a map that is not one
+    throw CalibrationError(path + ":" + std::to_string(e.mark.line + 1) +
+                           ": not a valid calibration file (" + e.msg + ")");
   }
-  const cv::FileNode version = fs["format_version"];
-  if (version.empty() || !version.isInt())
-    throw CalibrationError(path + ": key 'format_version' is missing");
-  if (static_cast<int>(version) != kCalibrationFormatVersion) {
-    throw CalibrationError(path + ": format_version " + std::to_string(static_cast<int>(version)) +
-                           " is not supported (expected " +
-                           std::to_string(kCalibrationFormatVersion) + ")");
-  }
-  for (const char* key : {"image_width", "image_height"}) {
-    if (fs[key].empty() || !fs[key].isInt() || static_cast<int>(fs[key]) <= 0)
-      throw CalibrationError(path + ": key '" + key + "' must be a positive integer");
-  }
-  const int width = fs["image_width"], height = fs["image_height"];
-  StereoCalibration c;
-  c.left = read_camera(fs["camera_left"], path, "camera_left", width, height, &c.rms_left);
-  c.right = read_camera(fs["camera_right"], path, "camera_right", width, height, &c.rms_right);
-  c.source = fs["source"].empty() ? "" : static_cast<std::string>(fs["source"]);
-  c.date = fs["date"].empty() ? "" : static_cast<std::string>(fs["date"]);
-  return c;
 }
 
 }  // namespace sg::vision

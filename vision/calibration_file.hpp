@@ -35,8 +35,9 @@ inline constexpr int kCalibrationFormatVersion = 1;
 /// partial file over a good one.
 void write_calibration(const std::string& path, const StereoCalibration& calibration);
 
-/// Reads a file written by write_calibration; throws CalibrationError naming a missing or
-/// malformed key.
+/// Reads a file written by write_calibration (with yaml-cpp: OpenCV's FileStorage parser crashes
+/// or hangs on some malformed files); throws CalibrationError naming a missing or malformed key
+/// and its line.
 StereoCalibration read_calibration(const std::string& path);
 
 }  // namespace sg::vision

@@ -4,9 +4,13 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <future>
+#include <memory>
 #include <sstream>
+#include <thread>
 
 #include "tests/support/subprocess.hpp"
 
@@ -102,6 +106,28 @@ TEST(CalibrationFile, FailedWriteKeepsTheOldFile) {
   std::swap(swapped.left, swapped.right);
   EXPECT_THROW(write_calibration(path, swapped), CalibrationError);
   EXPECT_EQ(test::read_text(path), before);
+}
+
+// A truncated file that made OpenCV's FileStorage loop for ever (fuzz/calibration_fuzz) is
+// refused, naming the file, within a deadline.
+TEST(CalibrationFile, TruncatedYamlThatHungOpenCvIsRefused) {
+  const std::string path = test::make_temp_dir() + "/hang.yaml";
+  std::ofstream(path, std::ios::binary) << "%YAML:1.0\n---%YAML:1.0\n\nf---\nformat_verso";
+  auto outcome = std::make_shared<std::promise<std::string>>();
+  std::thread([outcome, path] {  // detached: a hang must fail the test, not block it
+    try {
+      read_calibration(path);
+      outcome->set_value("accepted");
+    } catch (const CalibrationError& e) {
+      outcome->set_value(e.what());
+    }
+  })
+      .detach();
+  std::future<std::string> error = outcome->get_future();
+  ASSERT_EQ(error.wait_for(std::chrono::seconds(10)), std::future_status::ready)
+      << "read_calibration hangs";
+  const std::string what = error.get();
+  EXPECT_TRUE(what.starts_with(path + ":")) << what;
 }
 
 }  // namespace
