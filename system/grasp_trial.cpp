@@ -6,6 +6,8 @@
 #include <stop_token>
 #include <vector>
 
+#include "auth/command_auth.hpp"
+#include "auth/lab_key.hpp"
 #include "common/change_or_period.hpp"
 #include "grasp/grasp_node.hpp"
 #include "predictor/trajectory_message.hpp"
@@ -27,6 +29,13 @@ using stereograsp::point3_t;
 constexpr double kGraspLoopPeriod = 0.010;
 /// sg-arm-driver's loop handles the bus for 5 ms, then publishes ARM_STATUS when due.
 constexpr double kDriverLoopPeriod = 0.005;
+
+/// The trial's lab key: fixed bytes (the trial signs and checks as the lab does; no secret here).
+auth::LabKey trial_key() {
+  std::array<uint8_t, auth::LabKey::kSize> bytes;
+  for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = static_cast<uint8_t>(0xA5 ^ (i * 7));
+  return auth::LabKey(bytes);
+}
 
 /// A message as its subscribers receive it: encoded and decoded as on the bus.
 template <class T>
@@ -67,6 +76,8 @@ class Trial {
   void grasp_loop(double t);                        // sg-grasp's loop
   void driver_loop(double t);                       // sg-arm-driver's loop
   void operator_command(int8_t command, double t);  // sg-grasp-ctl
+  void send_arm_command(arm_cmd_t command);          // sg-grasp's signed publish
+  void on_arm_command(const arm_cmd_t& command);     // sg-arm-driver's subscription
   template <class F>
   void deliver(F&& f) {
     clock_.at(clock_.now() + p_.bus_latency, std::forward<F>(f));
@@ -89,6 +100,10 @@ class Trial {
   vision::StereoStep vision_;
   predictor::TrajectoryPredictor predictor_;
   grasp::GraspNode node_;
+  auth::LabKey key_ = trial_key();
+  auth::CommandSigner grasp_signer_{key_, "sg-grasp@trial:1", clock_};
+  auth::CommandSigner operator_signer_{key_, "sg-grasp-ctl@trial:2", clock_};
+  auth::CommandVerifier driver_verifier_{key_};
   ChangeOrPeriod arm_status_rule_;
   std::stop_source stop_;
 
@@ -126,6 +141,7 @@ Trial::Trial(const TrialParams& p)
       node_(p.arm, p.grasp, kTrialEpochUtime, 1.0 / p.grasp_status_rate),
       arm_status_rule_(1.0 / p.arm_status_rate) {
   p_.sim.frame_rate = p.frame_rate;
+  node_.require_signed_commands(key_, "GRASP_COMMAND");
   if (p_.render) camera_ = std::make_unique<sim::CameraSimulator>(p_.sim);
 }
 
@@ -193,10 +209,25 @@ void Trial::on_position(const point3_t& position) {
 
 void Trial::grasp_loop(double) {
   const grasp::GraspNode::Output out = node_.poll(clock_.utime());
+  if (out.lease) send_arm_command(*out.lease);  // MODE_HEARTBEAT / MODE_RELEASE
   if (!out.arm_command) return;
   ++result_.requests;
   if (out.arm_command->gripper == arm_cmd_t::GRIPPER_CLOSE) close_command_ = out.arm_command;
-  deliver([this, m = over_bus(*out.arm_command)](double) { driver_.submit(m); });
+  send_arm_command(*out.arm_command);
+}
+
+void Trial::send_arm_command(arm_cmd_t command) {
+  grasp_signer_.sign("ARM_COMMAND", command);
+  deliver([this, m = over_bus(command)](double) { on_arm_command(m); });
+}
+
+void Trial::on_arm_command(const arm_cmd_t& command) {
+  const auth::Verification v = driver_verifier_.verify("ARM_COMMAND", command, clock_.utime());
+  if (v.accepted()) {
+    driver_.submit(command);
+  } else {
+    driver_.refuse(command, "unauthenticated: " + v.reason);
+  }
 }
 
 void Trial::driver_loop(double t) {
@@ -217,7 +248,7 @@ void Trial::operator_command(int8_t command, double t) {
   c.sequence = ++operator_sequence_;
   c.command = command;
   c.standoff = 0;  // sg-grasp's own
-  c.sender = "sg-grasp-ctl";
+  operator_signer_.sign("GRASP_COMMAND", c);
   deliver([this, m = over_bus(c)](double) {
     const grasp::CommandRecord& answer = node_.on_command(m, clock_.utime());
     if (m.command == stereograsp::grasp_command_t::COMMAND_GRASP &&

@@ -171,10 +171,17 @@ TEST(Calibrate, RobotGuidedOverLcm) {
   const auto rig = sim::make_rig({});
   Bus bus(test_url(kPort));
   Eigen::Vector3d ball = Eigen::Vector3d::Zero();
-  int64_t executed = -1, commands = 0;
+  int64_t executed = -1, commands = 0, releases = 0;
   bool moving = false;
   auto arrive_at = std::chrono::steady_clock::now();
   bus.subscribe<stereograsp::arm_cmd_t>("ARM_COMMAND", [&](const auto& c, const auto&) {
+    // The commander's lease messages move nothing (docs/arm.md): heartbeats while it waits, one
+    // release at the end.
+    if (c.mode == stereograsp::arm_cmd_t::MODE_HEARTBEAT) return;
+    if (c.mode == stereograsp::arm_cmd_t::MODE_RELEASE) {
+      ++releases;
+      return;
+    }
     ball = {c.position[0], c.position[1], c.position[2]};
     executed = c.sequence;
     moving = true;
@@ -211,6 +218,7 @@ TEST(Calibrate, RobotGuidedOverLcm) {
   EXPECT_NE(r.out.find("18 stops (0 skipped"), std::string::npos) << r.out;
   EXPECT_NE(r.err.find("stop 18 of 18: collecting"), std::string::npos) << "progress lines";
   EXPECT_EQ(commands, 18);
+  EXPECT_EQ(releases, 1) << "sg-calibrate robot gives the arm back when done";
   const auto c = vision::read_calibration(dir + "/robot.yaml");
   double sum = 0;
   const auto points = workspace_points(50, 31);

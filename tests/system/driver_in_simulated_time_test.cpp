@@ -25,6 +25,21 @@ struct Rig {
         serial(emulator, clock),
         driver(arm::ArmGeometry::a465(), settings, [this] { return serial.connect(); }, clock) {}
 
+  /// The commander's heartbeat (sender "test", as test::tool_down_move) every 0.2 s from `from`
+  /// s: it stays present while its motion lasts, so the driver's watchdog lets the motion run.
+  void keep_commanding(double from) {
+    clock.every(
+        0.2,
+        [this](double) {
+          stereograsp::arm_cmd_t h{};
+          h.mode = stereograsp::arm_cmd_t::MODE_HEARTBEAT;
+          h.speed = 0.5;
+          h.sender = "test";
+          driver.submit(h);
+        },
+        from);
+  }
+
   /// Runs the driver until `end` s of simulated time.
   void run_until(double end) {
     clock.at(end, [this](double) { stop.request_stop(); });
@@ -49,6 +64,7 @@ TEST(DriverInSimulatedTime, OneCommandOneMotion) {
   Rig r;
   const auto c = test::tool_down_move(1, 0.45, 0.0, 0.20, std::numbers::pi / 2);
   r.clock.at(1.0, [&](double) { r.driver.submit(c); });
+  r.keep_commanding(1.0);
   r.run_until(8.0);
   EXPECT_EQ(r.lines_starting("MA "), 1);
   const arm_status_t s = r.driver.status().first;
@@ -71,6 +87,7 @@ TEST(DriverInSimulatedTime, BurstDuringAnInteractionKeepsOnlyTheNewest) {
     for (int k = 0; k < 100; ++k)
       r.driver.submit(test::tool_down_move(2 + k, 0.45, 0.001 * k, 0.20, std::numbers::pi / 2));
   });
+  r.keep_commanding(1.0);
   r.run_until(10.0);
   EXPECT_EQ(r.lines_starting("MA "), 2);
   EXPECT_EQ(r.driver.status().first.last_executed_sequence, 101);
