@@ -103,12 +103,15 @@ double C550Emulator::next_output_time() const {
 std::vector<std::string> C550Emulator::take_events() { return std::exchange(events_, {}); }
 
 void C550Emulator::pump(double now) {
+  // Bytes that arrived while a reply was held are handled once it has gone, in order; a byte
+  // handled here may defer a reply that is already due, which goes before the next byte
+  // (fuzz/c550_emulator_fuzz: it was left queued, due in the past).
   run_deferred(now);
-  // Bytes that arrived while a reply was held are handled once it has gone, in order.
   while (!input_.empty() && hold_until_ <= now) {
     const Input in = input_.front();
     input_.pop_front();
     process(in.byte, std::max(in.t, hold_until_));
+    run_deferred(now);
   }
 }
 
