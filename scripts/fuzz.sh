@@ -75,9 +75,10 @@ printf '%-16s %12s %10s %8s %8s  %s\n' target runs exec/s cov crashes result
 for t in "${targets[@]}"; do
   log="$build/logs/$t.log"
   status=$(cat "$build/logs/$t.status")
-  runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
-  speed=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -n 1)
-  cov=$(grep -o 'cov: [0-9]*' "$log" | tail -n 1 | cut -d' ' -f2)
+  # (|| true: a target that failed on a seed printed no statistics)
+  runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1 || true)
+  speed=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -n 1 || true)
+  cov=$({ grep -o 'cov: [0-9]*' "$log" || true; } | tail -n 1 | cut -d' ' -f2)
   crashes=$(find "$build/artifacts/$t" -type f -newer "$build/logs/$t.start" | wc -l)
   reports=$(grep -c -E 'ERROR: (AddressSanitizer|LeakSanitizer|libFuzzer)|runtime error:|fuzz check failed' "$log" || true)
   result=ok
