@@ -235,10 +235,16 @@ void ArmDriver::disconnect(const std::string& why) {
 void ArmDriver::read_joints() {
   const Joints q = to_joints(link_->read_joints());
   update([&](Status& s) {
+    // Moving: not yet at the joint target sent, or still changing since the last read (a HOME,
+    // whose target is the controller's ready pose, has no joint target here).
+    const bool changing =
+        have_read_ && (q - current_).cwiseAbs().maxCoeff() > settings_.arrived_tolerance;
     current_ = q;
+    have_read_ = true;
     set_joints(validator_.geometry(), q, s);
     const bool moving =
-        commanded_ && (q - *commanded_).cwiseAbs().maxCoeff() > settings_.arrived_tolerance;
+        changing ||
+        (commanded_ && (q - *commanded_).cwiseAbs().maxCoeff() > settings_.arrived_tolerance);
     if (s.state != Status::STATE_ERROR)
       s.state = moving ? Status::STATE_MOVING : Status::STATE_IDLE;
     if (!moving) s.source_utime = 0;

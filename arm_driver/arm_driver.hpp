@@ -136,6 +136,7 @@ class ArmDriver {
   std::optional<ArmTarget> pending_;
   std::optional<Joints> commanded_;  ///< the last joint target sent
   Joints current_ = Joints::Zero();
+  bool have_read_ = false;  ///< current_ was read from the controller (since the start)
   stereograsp::arm_status_t status_;
   uint64_t version_ = 0;
   double overhead_ = 0;

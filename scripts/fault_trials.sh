@@ -52,7 +52,8 @@ out="logs/$(date +%Y%m%d-%H%M%S)-fault-trials.txt"
 echo "fault_trials: full output in $out"
 export SG_FAULT_TABLE="$work/table.md"
 status=0
-"$bin/integration_fault_injection_test" --gtest_filter="FaultInjection.$filter" > "$out" 2>&1 ||
+gtest_filter=$(echo "$filter" | sed 's/\([^:]*\)/FaultInjection.\1/g')
+"$bin/integration_fault_injection_test" --gtest_filter="$gtest_filter" > "$out" 2>&1 ||
   status=$?
 echo "| fault | moment | what the arm did | sg-c550-sim's command log | reported |"
 echo "|---|---|---|---|---|"

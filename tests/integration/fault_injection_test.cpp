@@ -81,6 +81,17 @@ int acts_between(const CommandAudit& a, int64_t from, int64_t to) {
   return n;
 }
 
+/// The ARM_COMMAND seen since `from`, one a line (for failure messages).
+std::string recent_commands(const LoopObserver& seen, int64_t from) {
+  std::ostringstream out;
+  for (const CommandSeen& c : seen.commands()) {
+    if (c.recv_utime >= from)
+      out << c.recv_utime << " " << c.sender << " mode " << int{c.mode} << " #" << c.sequence
+          << "\n";
+  }
+  return out.str();
+}
+
 class FaultInjection : public ::testing::Test {
  protected:
   static void SetUpTestSuite() { files_ = new LoopFiles(LoopFiles::make()); }
@@ -168,10 +179,12 @@ TEST_F(FaultInjection, KillGraspHoldingTheBall) {
       },
       60s, "the ball held"));
   const int64_t killed = loop->kill("grasp");
-  ctl.wait(5s);
+  const std::string holder = loop->seen().arm().commander;
+  ctl.signal(SIGINT);  // its sg-grasp is gone; never block here: the bus must keep being read
   const int64_t last = loop->seen().last_command_from("sg-grasp@", killed);
   const double delay = stop_delay(*loop, last);
-  EXPECT_LE(delay, kStopBound);
+  EXPECT_LE(delay, kStopBound) << "lease holder at the kill: '" << holder << "'; commands:\n"
+                               << recent_commands(loop->seen(), last - 3'000'000) << loop->logs();
   loop->start("grasp");
   const int64_t restarted = now_utime();
   loop->watch_for(5s);
@@ -185,6 +198,36 @@ TEST_F(FaultInjection, KillGraspHoldingTheBall) {
           "at rest " + seconds(delay) + " after its last message; ball still held",
           log_summary(audit) + "; 0 acts in 5 s after the restart",
           "restarted sg-grasp: q3 hand closed, idle"});
+}
+
+// kill -9 of sg-grasp in the middle of a long move (HOME at 10% speed): the driver's watchdog
+// sends ABORT (the gripper kept) within the silence plus one interaction of sg-grasp's last
+// message, and the arm stops there.
+TEST_F(FaultInjection, KillGraspDuringALongMove) {
+  FaultLoop::Options slow;
+  slow.grasp_args = {"--speed", "0.1"};
+  auto loop = tracking_loop(7954, slow);
+  ASSERT_FALSE(HasFailure()) << loop->logs();
+  ASSERT_EQ(loop->grasp_ctl({"home"}, 30s).exit_code, 0);
+  const int64_t asked = now_utime();
+  ASSERT_TRUE(loop->eventually(
+      [&] {
+        const CommandAudit a = audit_commands(loop->command_log());
+        return !a.acts.empty() && a.acts.back() > asked && !loop->seen().at_rest_since(asked, 0.3);
+      },
+      30s, "the HOME under way"));
+  const int64_t killed = loop->kill("grasp");
+  const int64_t last = loop->seen().last_command_from("sg-grasp@", killed);
+  const double delay = stop_delay(*loop, last);
+  EXPECT_LE(delay, kStopBound) << recent_commands(loop->seen(), last - 3'000'000) << loop->logs();
+  const CommandAudit audit = judge_run(*loop);
+  ASSERT_FALSE(audit.aborts.empty()) << "no ABORT: the move ended before the watchdog acted";
+  const double abort_after = (audit.aborts.back() - last) * 1e-6;
+  EXPECT_GE(abort_after, kCommanderTimeout - 0.05);
+  EXPECT_LE(abort_after, kStopBound);
+  record({"kill -9 sg-grasp", "a long move (HOME at 10% speed)",
+          "ABORT " + seconds(abort_after) + " after its last message, at rest " + seconds(delay),
+          log_summary(audit), "ARM_STATUS.watchdog \"" + loop->seen().arm().watchdog + "\""});
 }
 
 // kill -9 of sg-arm-driver while tracking: the controller finishes its last move (nothing can
@@ -263,7 +306,7 @@ TEST_F(FaultInjection, KillControllerWhileTracking) {
 // The serial line closes mid-run (sg-c550-sim --disconnect-after) and comes back 2 s later: the
 // driver reconnects, nothing is sent twice, tracking goes on.
 TEST_F(FaultInjection, SerialDisconnect) {
-  auto loop = tracking_loop(7947, {{"--disconnect-after", "30", "--reconnect-after", "2"}, {}});
+  auto loop = tracking_loop(7947, {{"--disconnect-after", "30", "--reconnect-after", "2"}, {}, {}});
   ASSERT_FALSE(HasFailure()) << loop->logs();
   bool disconnected = false;
   loop->eventually(
@@ -285,7 +328,7 @@ TEST_F(FaultInjection, SerialDisconnect) {
 // Garbled serial bytes (1% of what the controller sends): the ACI layer's checks and retries
 // deliver every command once; the grasp is attempted and judged.
 TEST_F(FaultInjection, GarbledSerialBytes) {
-  auto loop = tracking_loop(7948, {{"--garble-rate", "0.01", "--seed", "15"}, {}});
+  auto loop = tracking_loop(7948, {{"--garble-rate", "0.01", "--seed", "15"}, {}, {}});
   ASSERT_FALSE(HasFailure()) << loop->logs();
   const int code = grasp(*loop);
   const CommandAudit audit = judge_run(*loop);
@@ -297,7 +340,7 @@ TEST_F(FaultInjection, GarbledSerialBytes) {
 // Dropped ACKs (20% of the controller's): a command whose ACK is lost is not sent again once it
 // reached the controller; the grasp is attempted and judged.
 TEST_F(FaultInjection, DroppedAcks) {
-  auto loop = tracking_loop(7949, {{"--drop-ack-rate", "0.2", "--seed", "15"}, {}});
+  auto loop = tracking_loop(7949, {{"--drop-ack-rate", "0.2", "--seed", "15"}, {}, {}});
   ASSERT_FALSE(HasFailure()) << loop->logs();
   const int code = grasp(*loop);
   const CommandAudit audit = judge_run(*loop);

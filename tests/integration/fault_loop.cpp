@@ -3,6 +3,7 @@
 #include <signal.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
@@ -80,8 +81,10 @@ LoopObserver::LoopObserver(Bus& bus) {
                                        [this](const auto& m, const auto&) { ball_ = m; });
   bus.subscribe<stereograsp::sim_arm_state_t>(
       "SIM_ARM_STATE", [this](const stereograsp::sim_arm_state_t& m, const ReceiveInfo& info) {
-        sim_.push_back({info.recv_utime, Eigen::Map<const arm::Joints>(m.joints),
-                        m.holding_object != 0});
+        // The simulator's own time stamp (the same host's clock): a moment the test was busy
+        // elsewhere delays the receipt, not the truth's timeline.
+        (void)info;
+        sim_.push_back({m.utime, Eigen::Map<const arm::Joints>(m.joints), m.holding_object != 0});
       });
 }
 
@@ -190,7 +193,11 @@ std::vector<std::string> FaultLoop::argv(const std::string& name) const {
     a.insert(a.end(), options_.c550_args.begin(), options_.c550_args.end());
     return a;
   }
-  if (name == "driver") return {program("sg-arm-driver"), "--lcm-url", url_, "--device", dir_ + "/c550"};
+  if (name == "driver") {
+    const char* level = std::getenv("SG_FAULT_DRIVER_LOG_LEVEL");  // e.g. debug, to see why
+    return {program("sg-arm-driver"), "--lcm-url", url_, "--device", dir_ + "/c550",
+            std::string("--log-level=") + (level ? level : "info")};
+  }
   if (name == "vision")
     return {program("sg-vision"), "--lcm-url", url_, "--calibration", files_.calibration, quiet};
   if (name == "predictor")
@@ -200,6 +207,7 @@ std::vector<std::string> FaultLoop::argv(const std::string& name) const {
     std::vector<std::string> a = options_.grasp_prefix;
     for (const std::string& s : {program("sg-grasp"), std::string("--lcm-url"), url_})
       a.push_back(s);
+    a.insert(a.end(), options_.grasp_args.begin(), options_.grasp_args.end());
     return a;
   }
   if (name == "cameras") return {program("sg-camera-sim"), "--lcm-url", url_, "--rate", "10", quiet};
@@ -247,20 +255,25 @@ int64_t FaultLoop::kill(const std::string& name) {
   return when;
 }
 
+ProcessResult FaultLoop::run_watching(const std::vector<std::string>& argv,
+                                      std::chrono::milliseconds timeout) {
+  Child child(argv);
+  wait_until(*bus_, [&] { return !child.running(); }, timeout);
+  return child.wait(1s);
+}
+
 ProcessResult FaultLoop::grasp_ctl(const std::vector<std::string>& args,
                                    std::chrono::milliseconds timeout) {
   std::vector<std::string> a = {program("sg-grasp-ctl"), "--lcm-url", url_};
   a.insert(a.end(), args.begin(), args.end());
-  ProcessResult r = run(a, timeout);
-  watch_for(0ms);
-  return r;
+  return run_watching(a, timeout);
 }
 
 ProcessResult FaultLoop::arm_ctl(const std::vector<std::string>& args,
                                  std::chrono::milliseconds timeout) {
   std::vector<std::string> a = {program("sg-arm-ctl"), "--lcm-url", url_};
   a.insert(a.end(), args.begin(), args.end());
-  return run(a, timeout);
+  return run_watching(a, timeout);
 }
 
 bool FaultLoop::track() {
@@ -283,8 +296,10 @@ std::string FaultLoop::logs() {
   std::string out = finished_logs_;
   for (auto& [name, child] : children_) {
     if (!child) continue;
+    const std::string err = read_text(child->err_path());
     out += name + " (pid " + std::to_string(child->pid()) + ", running " +
-           (child->running() ? "yes" : "no") + ")\n";
+           (child->running() ? "yes" : "no") + "), the end of its stderr:\n" +
+           err.substr(err.size() > 3000 ? err.size() - 3000 : 0) + "\n";
   }
   return out;
 }

@@ -49,7 +49,7 @@ struct CommandSeen {
 
 /// The simulator's truth at a moment.
 struct SimSample {
-  int64_t recv_utime = 0;
+  int64_t recv_utime = 0;  ///< SIM_ARM_STATE.utime: the simulator's clock (this host's)
   arm::Joints joints = arm::Joints::Zero();
   bool holding = false;
 };
@@ -114,6 +114,7 @@ class FaultLoop {
   struct Options {
     std::vector<std::string> c550_args;    ///< extra sg-c550-sim flags (line faults)
     std::vector<std::string> grasp_prefix; ///< run sg-grasp under this (e.g. faketime -f +1s)
+    std::vector<std::string> grasp_args;   ///< extra sg-grasp flags (e.g. --speed 0.1)
   };
 
   FaultLoop(int port, LoopFiles files, Options options);
@@ -126,7 +127,7 @@ class FaultLoop {
   void start(const std::string& name);
   /// SIGKILL, then reaps it; returns the time of the kill.
   int64_t kill(const std::string& name);
-  /// Runs sg-grasp-ctl with `args` (and the loop's URL); its result.
+  /// Runs sg-grasp-ctl with `args` (and the loop's URL), watching the bus meanwhile.
   ProcessResult grasp_ctl(const std::vector<std::string>& args,
                           std::chrono::milliseconds timeout = std::chrono::seconds(60));
   /// Runs sg-arm-ctl with `args`.
@@ -152,6 +153,9 @@ class FaultLoop {
 
  private:
   std::vector<std::string> argv(const std::string& name) const;
+  /// Runs `argv` to its end (or `timeout`) while the observer keeps handling the bus.
+  ProcessResult run_watching(const std::vector<std::string>& argv,
+                             std::chrono::milliseconds timeout);
 
   int port_;
   LoopFiles files_;

@@ -35,6 +35,8 @@ class Child {
   ProcessResult wait(std::chrono::milliseconds timeout);
 
   pid_t pid() const { return pid_; }
+  /// The file its stderr goes to (readable while it runs).
+  const std::string& err_path() const { return err_path_; }
 
  private:
   pid_t pid_ = -1;
