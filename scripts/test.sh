@@ -28,8 +28,8 @@ shift
 # ---- --sanitize ----
 scripts/bootstrap.sh --no-build
 build=${SG_SANITIZE_BUILD:-build-asan}
-# -O1, as the sanitizers' authors advise: reports keep their lines, and the build is about half
-# as long as -O3's (Release); assert() stays on (no NDEBUG).
+# -O1, as the sanitizers' authors advise: reports keep their lines, the build is shorter than
+# -O3's (Release); assert() stays on (no NDEBUG).
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 \
   -DSG_SANITIZE=ON -DSG_BUILD_BENCH=OFF >/dev/null
 # SG_SANITIZE_TARGETS (CI: scripts/sanitizer/ci-targets.txt) builds only those targets and runs
