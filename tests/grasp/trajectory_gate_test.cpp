@@ -139,14 +139,14 @@ struct Rig {
     arm.last_executed_sequence = arm.last_rejected_sequence = -1;
     node.on_arm_status(arm, now);
   }
-  /// Polls 10 ms on; a command is executed at once. Returns the command sent, if any.
+  /// Polls 10 ms on; a command is executed at once, and ARM_STATUS comes every step (as the
+  /// driver's does, at 10 Hz or more: a silent one stops sg-grasp's requests). Returns the
+  /// command sent, if any.
   std::optional<stereograsp::arm_cmd_t> step() {
     now += 10'000;
     const GraspNode::Output out = node.poll(now);
-    if (out.arm_command) {
-      arm.last_executed_sequence = out.arm_command->sequence;
-      node.on_arm_status(arm, now);
-    }
+    if (out.arm_command) arm.last_executed_sequence = out.arm_command->sequence;
+    node.on_arm_status(arm, now);
     return out.arm_command;
   }
   const CommandRecord& track() {
