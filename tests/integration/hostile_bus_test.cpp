@@ -33,7 +33,7 @@ namespace sg::test {
 namespace {
 
 using namespace std::chrono_literals;
-constexpr int kPort = 7930;
+constexpr int kPort = 7960;  // its own: bus_probe_test uses 7930-7932
 constexpr int64_t kMaxGrowth = 100LL << 20;  // the figure's bound: 100 MB over the RSS at rest
 
 /// VmRSS of process `pid` in bytes, from /proc/PID/status (0 when it is gone).
