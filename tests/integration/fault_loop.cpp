@@ -12,6 +12,7 @@
 
 #include "common/clock.hpp"
 #include "tests/integration/multicast_guard.hpp"
+#include "tests/support/paper_circle.hpp"
 #include "tests/support/wait.hpp"
 
 namespace sg::test {
@@ -20,15 +21,6 @@ namespace {
 using namespace std::chrono_literals;
 using Cmd = stereograsp::arm_cmd_t;
 
-/// Four minutes of the paper's circle without drift (0.15 m around (0.45, 0, 0.10), 1 rpm) at
-/// 4 Hz as t,x,y,z lines: what `sg-predictor train` learns its starting coefficients from.
-void write_circle(const std::string& path) {
-  std::ofstream out(path);
-  for (int k = 0; k < 960; ++k) {
-    const double t = 0.25 * k, a = 2 * std::numbers::pi * t / 60.0;
-    out << t << "," << 0.45 + 0.15 * std::cos(a) << "," << 0.15 * std::sin(a) << ",0.10\n";
-  }
-}
 
 /// The joints of an "MA j1,...,j6" line (degrees in the line, radians out); nullopt otherwise.
 std::optional<arm::Joints> ma_joints(const std::string& command) {

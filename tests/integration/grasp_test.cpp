@@ -20,6 +20,7 @@
 #include "common/message_types.hpp"
 #include "tests/integration/multicast_guard.hpp"
 #include "tests/support/subprocess.hpp"
+#include "tests/support/paper_circle.hpp"
 #include "tests/support/wait.hpp"
 
 namespace sg::test {
@@ -27,15 +28,6 @@ namespace {
 
 using namespace std::chrono_literals;
 
-/// Four minutes of the paper's circle without drift (0.15 m around (0.45, 0, 0.10), 1 rpm) at
-/// 4 Hz as t,x,y,z lines: what `sg-predictor train` learns its starting coefficients from.
-void write_circle(const std::string& path) {
-  std::ofstream out(path);
-  for (int k = 0; k < 960; ++k) {
-    const double t = 0.25 * k, a = 2 * M_PI * t / 60.0;
-    out << t << "," << 0.45 + 0.15 * std::cos(a) << "," << 0.15 * std::sin(a) << ",0.10\n";
-  }
-}
 
 /// The newest ARM_STATUS, OBJECT_TRAJECTORY and GROUND_TRUTH on a bus, and when the newest
 /// SIM_ARM_STATE arrived: what the test waits on.

@@ -27,6 +27,7 @@
 #include "common/message_types.hpp"
 #include "tests/integration/multicast_guard.hpp"
 #include "tests/support/subprocess.hpp"
+#include "tests/support/paper_circle.hpp"
 #include "tests/support/wait.hpp"
 
 namespace sg::test {
@@ -99,14 +100,6 @@ struct Listener {
   stereograsp::sim_arm_state_t sim{};
 };
 
-/// Four minutes of the paper's circle at 4 Hz as t,x,y,z lines, for `sg-predictor train`.
-void write_circle(const std::string& path) {
-  std::ofstream out(path);
-  for (int k = 0; k < 960; ++k) {
-    const double t = 0.25 * k, a = 2 * M_PI * t / 60.0;
-    out << t << "," << 0.45 + 0.15 * std::cos(a) << "," << 0.15 * std::sin(a) << ",0.10\n";
-  }
-}
 
 /// The system at rest: the C550 and its driver, sg-grasp (idle: no GRASP_COMMAND is signed),
 /// the predictor, vision and the cameras (5 frame pairs a second).
