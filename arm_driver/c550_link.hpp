@@ -39,13 +39,13 @@ struct LinkTiming {
 /// retry. The line is still there; the caller may resynchronise and try again.
 class LinkError : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  explicit LinkError(std::string_view what) : std::runtime_error(rapl::printable(what)) {}
 };
 
 /// The controller understood the command and refused it: a `***` reply line.
 class ControllerError : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  explicit ControllerError(std::string_view what) : std::runtime_error(rapl::printable(what)) {}
 };
 
 /// Counters for status and benchmarks.

@@ -28,9 +28,13 @@ inline constexpr std::string_view kPrompt = "\r\n>>";
 inline constexpr size_t kMaxLine = 120;
 
 /// A malformed command or reply; the message names what was expected and what came.
+/// `text` with every byte outside printable ASCII written as \xNN: what a garbled serial line
+/// put into an error message reaches logs and ARM_STATUS as readable ASCII, never raw bytes.
+std::string printable(std::string_view text);
+
 class RaplError : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  explicit RaplError(std::string_view what) : std::runtime_error(printable(what)) {}
 };
 
 /// Joint angles in radians (joint 1..6).

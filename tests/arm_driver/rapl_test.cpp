@@ -390,5 +390,17 @@ TEST(RaplParseNumbers, Malformed) {
   }
 }
 
+// A garbled number's error names it in printable ASCII: the byte 0xdc from the line reads \xdc,
+// so no raw serial byte reaches a log or ARM_STATUS.error.
+TEST(RaplErrors, GarbledBytesArePrintedEscaped) {
+  try {
+    parse_numbers("0.0\xdc" "00 1.5");
+    FAIL() << "a garbled number was parsed";
+  } catch (const RaplError& e) {
+    EXPECT_STREQ(e.what(), "'0.0\\xdc00' is not a number");
+  }
+  EXPECT_EQ(printable(std::string("a\r\n\x7f\x00z", 6)), "a\\x0d\\x0a\\x7f\\x00z");
+}
+
 }  // namespace
 }  // namespace sg::arm::rapl
