@@ -40,9 +40,9 @@ class LoggerTest : public ::testing::Test {
         observer, [&] { return !sending.running(); }, 60s);  // reading what it sends
     const ProcessResult sender = sending.wait(1s);
     ASSERT_EQ(sender.exit_code, 0) << sender.err;
-    // Stop lcm-logger once every message has reached it and it has read them all.
+    // Stop lcm-logger once every message has reached it and it has handled them all.
     ASSERT_TRUE(eventually(
-        observer, [&] { return heard >= kCount && drained_bus(logger.pid(), 7902); }, 30s,
+        observer, [&] { return heard >= kCount && handled_bus(logger.pid(), 7902); }, 30s,
         "lcm-logger to read all " + std::to_string(kCount) + " messages"));
     logger.signal(SIGINT);
     const ProcessResult stopped = logger.wait(10s);

@@ -261,12 +261,12 @@ TEST(ReportLive, RecordedSessionFromTheRealPredictor) {
   const auto at = predicted.out.find("published ");
   ASSERT_NE(at, std::string::npos) << predicted.out << predicted.err;
   published = std::stoi(predicted.out.substr(at + 10));
-  // Stop lcm-logger once every position and forecast has reached it and it has read them all.
+  // Stop lcm-logger once every position and forecast has reached it and it has handled them all.
   ASSERT_TRUE(eventually(
       bus,
       [&] {
         return positions_heard >= kSent && forecasts_heard >= published &&
-               drained_bus(logger.pid(), 7922);
+               handled_bus(logger.pid(), 7922);
       },
       30s, "lcm-logger to read every position and forecast"));
   logger.signal(SIGINT);

@@ -1,5 +1,6 @@
 // The bus probes on real processes: joined_bus() says a process has subscribed on a udpm port
-// (and not on another), drained_bus() that it has read what reached it.
+// (and not on another), drained_bus() that it has read what reached it, idle() that none of its
+// threads has work.
 
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -52,6 +53,19 @@ TEST(DrainedBus, FalseWhileAMessageWaitsInTheSocket) {
   EXPECT_TRUE(eventually([&] { return drained_bus(receiver.pid(), kPort + 2); }, 30s,
                          "the receiver to read it"));
   EXPECT_FALSE(drained_bus(receiver.pid(), kPort)) << "no socket on that port";
+}
+
+// `sleep` sleeps; a shell in a busy loop is runnable; an exited process is not idle.
+TEST(Idle, TrueOnlyWhenEveryThreadSleeps) {
+  Child sleeping({"sleep", "30"});
+  EXPECT_TRUE(eventually([&] { return idle(sleeping.pid()); }, 10s, "`sleep` to sleep"));
+  Child busy({"sh", "-c", "while :; do :; done"});
+  int idle_seen = 0;
+  for (int k = 0; k < 10; ++k) idle_seen += idle(busy.pid()) ? 1 : 0;
+  EXPECT_EQ(idle_seen, 0) << "a busy loop is never seen asleep twice 20 ms apart";
+  busy.signal(SIGKILL);
+  busy.wait(10s);
+  EXPECT_FALSE(idle(busy.pid()));
 }
 
 }  // namespace

@@ -145,4 +145,35 @@ bool drained_bus(pid_t pid, int port) {
   return bound;
 }
 
+namespace {
+
+/// Whether every thread of `pid` is in state S now (false when it has none, or has exited).
+bool all_threads_sleep(pid_t pid) {
+  bool any = false;
+  std::error_code ec;
+  for (const auto& task :
+       std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/task", ec)) {
+    std::ifstream stat(task.path() / "stat");
+    std::string line;
+    if (!std::getline(stat, line)) return false;
+    const auto name_end = line.rfind(')');  // "TID (comm) STATE ..."; comm may hold spaces
+    if (name_end == std::string::npos || name_end + 2 >= line.size()) return false;
+    if (line[name_end + 2] != 'S') return false;
+    any = true;
+  }
+  return any && !ec;
+}
+
+}  // namespace
+
+bool idle(pid_t pid) {
+  if (!all_threads_sleep(pid)) return false;
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  return all_threads_sleep(pid);
+}
+
+bool handled_bus(pid_t pid, int port) {
+  return drained_bus(pid, port) && idle(pid) && drained_bus(pid, port);
+}
+
 }  // namespace sg::test

@@ -55,8 +55,19 @@ bool joined_bus(pid_t pid, int port);
 
 /// True when process `pid` has taken every datagram that reached its socket on udpm port `port`
 /// off that socket (its receive queue is empty): once this test has itself received the last
-/// message sent, the other subscriber holds it too. (lcm-logger writes what it took when it
-/// stops, but flushes only as later messages come, so its file cannot say so.)
+/// message sent, the other subscriber has read it too. Read, not yet handled: LCM passes it to the
+/// handler through its own ring buffer, and lcm-logger then to its write thread. See
+/// handled_bus().
 bool drained_bus(pid_t pid, int port);
+
+/// True when every thread of process `pid` sleeps (state S in /proc/PID/task/TID/stat: none
+/// runnable, none in disk wait), seen twice 20 ms apart.
+bool idle(pid_t pid);
+
+/// drained_bus() and idle(): `pid` has read what reached it and has handled it, nothing of it
+/// waits in a queue between its threads. lcm-logger needs this before it is stopped: on SIGINT its
+/// write thread exits at its next event and drops what is still queued for it (LCM 1.3.1's
+/// lcm_logger.c, write_thread_exit_flag).
+bool handled_bus(pid_t pid, int port);
 
 }  // namespace sg::test
