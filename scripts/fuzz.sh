@@ -1,23 +1,26 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (fuzz/, clang with ASan and UBSan) and runs each for a while.
+# They share the sanitized build of scripts/test.sh --sanitize (scripts/sanitizer/configure.sh).
 # Exits non-zero when any target crashes, fails one of its checks, or a sanitizer reports.
 #
 #   scripts/fuzz.sh SECONDS [TARGET...]   run each target (all by default) for SECONDS
 #   scripts/fuzz.sh --list                the targets
 #   scripts/fuzz.sh -h | --help
 #
-# Environment: SG_FUZZ_BUILD (default build-fuzz), SG_FUZZ_JOBS (targets run at once, default 1).
+# Environment: SG_FUZZ_BUILD (default build-sanitize), SG_FUZZ_JOBS (targets run at once,
+# default 1).
 #
 # Each target starts from a copy of its committed seeds (fuzz/corpus/NAME/) in
-# build-fuzz/corpus/NAME/, which keeps what the run found (copy new inputs back with care: the
-# committed corpus should stay small). A crashing input is kept in build-fuzz/artifacts/NAME/
-# and the fuzzer's output in build-fuzz/logs/NAME.log; reproduce with
-#   build-fuzz/fuzz/NAME_fuzz build-fuzz/artifacts/NAME/crash-...
+# build-sanitize/corpus/NAME/, which keeps what the run found (copy new inputs back with care:
+# the committed corpus should stay small). A crashing input is kept in
+# build-sanitize/artifacts/NAME/ and the fuzzer's output in build-sanitize/logs/NAME.log;
+# reproduce with
+#   build-sanitize/fuzz/NAME_fuzz build-sanitize/artifacts/NAME/crash-...
 # See docs/fuzzing.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-usage() { sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; }
 targets_all() { for f in fuzz/*_fuzz.cpp; do basename "$f" _fuzz.cpp; done; }
 
 case "${1:-}" in
@@ -33,12 +36,11 @@ for t in "${targets[@]}"; do
   [ -f "fuzz/${t}_fuzz.cpp" ] || { echo "fuzz.sh: no target '$t' (see --list)" >&2; exit 2; }
 done
 
-build=${SG_FUZZ_BUILD:-build-fuzz}
+build=${SG_FUZZ_BUILD:-build-sanitize}
 jobs=${SG_FUZZ_JOBS:-1}
 
 scripts/bootstrap.sh --no-build --with-clang
-cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=clang++ -DSG_FUZZ=ON \
-  -DSG_BUILD_TESTS=OFF -DSG_BUILD_BENCH=OFF >/dev/null
+scripts/sanitizer/configure.sh "$build"
 cmake --build "$build" -j "$(nproc)" --target "${targets[@]/%/_fuzz}"
 
 supp="$PWD/scripts/sanitizer"

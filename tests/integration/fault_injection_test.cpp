@@ -170,8 +170,8 @@ TEST_F(FaultInjection, KillGraspWhileTracking) {
 TEST_F(FaultInjection, KillGraspHoldingTheBall) {
   auto loop = tracking_loop(7942);
   ASSERT_FALSE(HasFailure()) << loop->logs();
-  Child ctl({program("sg-grasp-ctl"), "--lcm-url", loop->url(), "grasp", "--wait", "--timeout",
-             "40"});
+  Child ctl(
+      {program("sg-grasp-ctl"), "--lcm-url", loop->url(), "grasp", "--wait", "--timeout", "40"});
   ASSERT_TRUE(loop->eventually(
       [&] {
         const auto& sim = loop->seen().sim();
@@ -317,8 +317,10 @@ TEST_F(FaultInjection, SerialDisconnect) {
       40s, "the line lost");
   EXPECT_TRUE(disconnected);
   EXPECT_TRUE(loop->eventually(
-      [&] { return loop->seen().arm().state != stereograsp::arm_status_t::STATE_DISCONNECTED &&
-                   loop->seen().at_standoff(0.10); },
+      [&] {
+        return loop->seen().arm().state != stereograsp::arm_status_t::STATE_DISCONNECTED &&
+               loop->seen().at_standoff(0.10);
+      },
       60s, "reconnected and tracking"));
   const CommandAudit audit = judge_run(*loop);
   record({"serial disconnect (2 s)", "tracking", "held still while the line was down; tracks again",
@@ -358,8 +360,9 @@ bool iptables(const std::string& args) {
 // namespace; the kernel has no netem): sg-grasp resends what the driver never received under
 // the same sequence, the driver executes each once, and the grasp is attempted and judged.
 TEST_F(FaultInjection, PacketLoss30Percent) {
-  const std::string rule = "INPUT -p udp --dport 7950 -m statistic --mode random --probability "
-                           "0.3 -j DROP";
+  const std::string rule =
+      "INPUT -p udp --dport 7950 -m statistic --mode random --probability "
+      "0.3 -j DROP";
   auto loop = tracking_loop(7950);
   ASSERT_FALSE(HasFailure()) << loop->logs();
   ASSERT_TRUE(iptables("-I " + rule)) << "iptables could not add the loss rule (root, and "
@@ -457,6 +460,10 @@ TEST_F(FaultInjection, TwoCommanders) {
   EXPECT_TRUE(loop->seen().at_standoff(0.10) ||
               loop->eventually([&] { return loop->seen().at_standoff(0.10); }, 20s,
                                "the holder still tracking"));
+  // The refusal needs a live holder: a lease its holder let lapse is free, and taken.
+  ASSERT_TRUE(loop->eventually([&] { return !loop->seen().arm().commander.empty(); }, 20s,
+                               "a commander holding the lease"))
+      << loop->logs();
   const ProcessResult refused = loop->arm_ctl({"move", "0.45", "0.0", "0.30"}, 30s);
   EXPECT_EQ(refused.exit_code, 1) << refused.out << refused.err;
   const ProcessResult taken = loop->arm_ctl({"move", "0.45", "0.0", "0.30", "--take-over"}, 60s);
@@ -490,8 +497,7 @@ TEST_F(FaultInjection, ClockSkewGraspAhead) {
   EXPECT_TRUE(followed || !message.empty()) << "neither followed nor said why";
   const CommandAudit audit = judge_run(loop);
   record({"clock skew: sg-grasp's host 2 s ahead", "asked to track",
-          followed ? "followed the ball" : "did not follow the ball",
-          log_summary(audit),
+          followed ? "followed the ball" : "did not follow the ball", log_summary(audit),
           "sg-grasp-ctl track exit " + std::to_string(tracked.exit_code) + "; GRASP_STATUS \"" +
               message + "\""});
 }

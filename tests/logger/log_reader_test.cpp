@@ -159,6 +159,7 @@ TEST(LogReader, GarbageInTheMiddleIsSkippedAndReported) {
     }
   }
   const int64_t two = 28 + 15 + static_cast<int64_t>(position_bytes(0).size());
+  EXPECT_EQ(at, 5 * two) << "each event: a 28-byte header, its channel and its body";
   const ReadBack r = read_all(path);
   EXPECT_EQ(r.utimes, kFive);
   ASSERT_EQ(r.problems.size(), 1u);
