@@ -149,9 +149,15 @@ bool Bus::publish_raw(const std::string& channel, const void* data, int size) {
 }
 
 void Bus::subscribe_raw(const std::string& channel_regex,
-                        std::function<void(const RawMessage&)> handler) {
+                        std::function<void(const RawMessage&)> handler, int queue) {
   handlers_.push_back(std::make_unique<RawHandler>(*this, std::move(handler)));
-  lcm_->subscribe(channel_regex, &RawHandler::handleMessage, handlers_.back().get());
+  lcm::Subscription* subscription =
+      lcm_->subscribe(channel_regex, &RawHandler::handleMessage, handlers_.back().get());
+  if (subscription == nullptr) throw BusError("cannot subscribe to '" + channel_regex + "'");
+  if (queue < 1 || subscription->setQueueCapacity(queue) != 0) {
+    throw BusError("cannot hold " + std::to_string(queue) + " messages for '" + channel_regex +
+                   "'");
+  }
 }
 
 bool Bus::handle(std::chrono::milliseconds timeout) {

@@ -33,6 +33,18 @@ struct RawMessage {
   const uint8_t* data = nullptr;
 };
 
+/// How many messages LCM holds for one subscription while its handler is busy; it drops what
+/// comes beyond that without a word (lcm_subscription_set_queue_capacity). LCM's own default is
+/// 30: 0.3 s of a 100 Hz stream, so a process that stalls that long (a loaded machine, a replay
+/// with `lcm-logplayer -s 10`) silently lost samples of a time series.
+///
+/// kQueueEverySample is the default: 256 messages, a minute of the paper's 4 Hz and 2.5 s at
+/// 100 Hz. Small messages queue in LCM's receive ring (1 MB), so a longer queue costs no memory
+/// beyond it. kQueueFrames is for camera images: LCM's 30, a second of video, already some MB
+/// (each a separate allocation), and a frame older than that is not worth processing.
+inline constexpr int kQueueEverySample = 256;
+inline constexpr int kQueueFrames = 30;
+
 /// The LCM bus every process talks through: typed publish and subscribe over `lcm::LCM`, with
 /// clear errors where LCM itself only prints or returns a code.
 ///
@@ -79,23 +91,29 @@ class Bus {
 
   /// Calls `handler` with each message on channels matching `channel_regex` that decodes as
   /// Message, exactly and completely.
+  /// LCM holds up to `queue` of them while the handler is busy (kQueueEverySample).
   template <class Message>
   void subscribe(const std::string& channel_regex,
-                 std::function<void(const Message&, const ReceiveInfo&)> handler) {
-    subscribe_raw(channel_regex, [this, handler = std::move(handler)](const RawMessage& raw) {
-      Message message{};
-      if (DecodeResult r = safe_decode(raw.data, raw.info.size, message); !r) {
-        report_decode_error(raw.info, r.reason);
-        return;
-      }
-      handler(message, raw.info);
-    });
+                 std::function<void(const Message&, const ReceiveInfo&)> handler,
+                 int queue = kQueueEverySample) {
+    subscribe_raw(
+        channel_regex,
+        [this, handler = std::move(handler)](const RawMessage& raw) {
+          Message message{};
+          if (DecodeResult r = safe_decode(raw.data, raw.info.size, message); !r) {
+            report_decode_error(raw.info, r.reason);
+            return;
+          }
+          handler(message, raw.info);
+        },
+        queue);
   }
 
   /// Calls `handler` with every message on matching channels, undecoded. What it throws is
-  /// caught and counted like a typed handler's.
+  /// caught and counted like a typed handler's. LCM holds up to `queue` of them while the
+  /// handler is busy.
   void subscribe_raw(const std::string& channel_regex,
-                     std::function<void(const RawMessage&)> handler);
+                     std::function<void(const RawMessage&)> handler, int queue = kQueueEverySample);
 
   /// Waits up to `timeout` for one message and dispatches it. Returns true when a message was
   /// handled, false on time-out (or an interrupting signal); throws BusError when LCM fails,

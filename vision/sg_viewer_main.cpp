@@ -29,15 +29,18 @@ int run(const std::string& url, sg::vision::ViewerSession& session, int64_t max_
   sg::install_shutdown_handlers();
   sg::Bus bus(url);
   bus.announce("sg-viewer");
-  bus.subscribe<image_t>("CAMERA_(LEFT|RIGHT)", [&](const image_t& m, const sg::ReceiveInfo& info) {
-    std::string error;
-    auto image = sg::vision::decode_image(m, &error);
-    if (!image) {
-      spdlog::warn("{}: dropped an image: {}", info.channel, error);
-      return;
-    }
-    session.on_image(info.channel == "CAMERA_LEFT" ? 0 : 1, m.utime, *image);
-  });
+  bus.subscribe<image_t>(
+      "CAMERA_(LEFT|RIGHT)",
+      [&](const image_t& m, const sg::ReceiveInfo& info) {
+        std::string error;
+        auto image = sg::vision::decode_image(m, &error);
+        if (!image) {
+          spdlog::warn("{}: dropped an image: {}", info.channel, error);
+          return;
+        }
+        session.on_image(info.channel == "CAMERA_LEFT" ? 0 : 1, m.utime, *image);
+      },
+      sg::kQueueFrames);
   bus.subscribe<blob_t>("BLOB_(LEFT|RIGHT)", [&](const blob_t& b, const sg::ReceiveInfo& info) {
     session.on_blob(info.channel == "BLOB_LEFT" ? 0 : 1, b);
   });

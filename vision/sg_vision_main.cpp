@@ -111,8 +111,8 @@ int run_lcm(sg::Bus& bus, StereoVision& vision, const Options& o) {
       ++frames;
     }
   };
-  bus.subscribe<image_t>("CAMERA_LEFT", on_image);
-  bus.subscribe<image_t>("CAMERA_RIGHT", on_image);
+  bus.subscribe<image_t>("CAMERA_LEFT", on_image, sg::kQueueFrames);
+  bus.subscribe<image_t>("CAMERA_RIGHT", on_image, sg::kQueueFrames);
   bus.announce("sg-vision");  // after subscribing: the first PROCESS_STATUS says it listens
   spdlog::info("waiting for CAMERA_LEFT and CAMERA_RIGHT");
   bus.spin([&] { return o.max_frames == 0 || frames < o.max_frames; });

@@ -5,8 +5,12 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <thread>
+
 #include "common/message_types.hpp"
 #include "common/shutdown.hpp"
+#include "tests/integration/multicast_guard.hpp"
+#include "tests/support/wait.hpp"
 
 namespace sg {
 namespace {
@@ -43,6 +47,34 @@ TEST(Bus, TypedPublishSubscribeOverMemq) {
   EXPECT_EQ(infos[0].channel, "OBJECT_POSITION");
   EXPECT_EQ(infos[0].size, make_point(0, 0).getEncodedSize());
   EXPECT_GT(infos[0].recv_utime, 0);
+}
+
+// A subscription holds kQueueEverySample messages while its handler is busy, not LCM's 30: udpm
+// drops what comes beyond a subscription's queue (memq:// does not, so this needs the network).
+TEST(Bus, QueueHoldsEverySampleOfABurst) {
+  ASSERT_TRUE(test::multicast_available(7970));
+  Bus bus(test::test_url(7970));
+  int samples = 0, frames = 0;
+  bus.subscribe<point3_t>("OBJECT_POSITION",
+                          [&](const point3_t&, const ReceiveInfo&) { ++samples; });
+  bus.subscribe<blob_t>(
+      "BLOB_LEFT", [&](const blob_t&, const ReceiveInfo&) { ++frames; }, kQueueFrames);
+  for (int i = 0; i < kQueueEverySample + 44; ++i) {  // more than either queue holds
+    bus.publish("OBJECT_POSITION", make_point(i, 0.0));
+    bus.publish("BLOB_LEFT", blob_t{});
+    if (i % 16 == 0) std::this_thread::sleep_for(1ms);  // within the kernel's socket buffer
+  }
+  // Once LCM's receive thread has read every datagram, each is queued or dropped.
+  ASSERT_TRUE(test::wait_until([&] { return test::drained_bus(getpid(), 7970); }, 10s));
+  std::this_thread::sleep_for(50ms);  // a datagram read is queued within microseconds
+  while (bus.handle(50ms)) {
+  }
+  // LCM 1.3.1 keeps one message beyond the capacity it is given (so with both capacities here).
+  EXPECT_EQ(samples, kQueueEverySample + 1);
+  EXPECT_EQ(frames, kQueueFrames + 1);
+  EXPECT_THROW(bus.subscribe<point3_t>(
+                   "X", [](const point3_t&, const ReceiveInfo&) {}, 0),
+               BusError);
 }
 
 // Channel patterns are regular expressions, as in LCM.
