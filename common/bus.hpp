@@ -39,9 +39,11 @@ struct RawMessage {
 /// with `lcm-logplayer -s 10`) silently lost samples of a time series.
 ///
 /// kQueueEverySample is the default: 256 messages, a minute of the paper's 4 Hz and 2.5 s at
-/// 100 Hz. Small messages queue in LCM's receive ring (1 MB), so a longer queue costs no memory
-/// beyond it. kQueueFrames is for camera images: LCM's 30, a second of video, already some MB
-/// (each a separate allocation), and a frame older than that is not worth processing.
+/// 100 Hz. A message of one datagram queues in LCM's receive ring (1 MB in LCM's udpm source),
+/// one of many fragments in a heap buffer of its size: a stalled handler holds at most `queue` of
+/// those (integration_hostile_bus_test's floods stay within its memory bound). kQueueFrames is for
+/// camera images: LCM's 30, a second of video, already some MB (each a separate allocation), and a
+/// frame older than that is not worth processing.
 inline constexpr int kQueueEverySample = 256;
 inline constexpr int kQueueFrames = 30;
 
