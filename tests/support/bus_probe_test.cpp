@@ -44,6 +44,8 @@ TEST(DrainedBus, FalseWhileAMessageWaitsInTheSocket) {
                          "sg-bus-check to join port 7932"));
   EXPECT_TRUE(drained_bus(receiver.pid(), kPort + 2));
   receiver.signal(SIGSTOP);
+  // Published before the stop took effect, the message is read at once (seen in a CI run).
+  ASSERT_TRUE(eventually([&] { return stopped(receiver.pid()); }, 10s, "the receiver to stop"));
   Bus bus(test_url(kPort + 2));
   const uint8_t byte = 1;
   bus.publish_raw("OTHER", &byte, 1);
@@ -66,6 +68,16 @@ TEST(Idle, TrueOnlyWhenEveryThreadSleeps) {
   busy.signal(SIGKILL);
   busy.wait(10s);
   EXPECT_FALSE(idle(busy.pid()));
+}
+
+// A process is stopped once SIGSTOP has taken effect, and no longer once continued.
+TEST(Stopped, TrueOnlyWhileEveryThreadIsStopped) {
+  Child sleeping({"sleep", "30"});
+  EXPECT_FALSE(stopped(sleeping.pid()));
+  sleeping.signal(SIGSTOP);
+  EXPECT_TRUE(eventually([&] { return stopped(sleeping.pid()); }, 10s, "`sleep` to stop"));
+  sleeping.signal(SIGCONT);
+  EXPECT_TRUE(eventually([&] { return !stopped(sleeping.pid()); }, 10s, "`sleep` to go on"));
 }
 
 }  // namespace

@@ -147,8 +147,8 @@ bool drained_bus(pid_t pid, int port) {
 
 namespace {
 
-/// Whether every thread of `pid` is in state S now (false when it has none, or has exited).
-bool all_threads_sleep(pid_t pid) {
+/// Whether every thread of `pid` is in `state` now (false when it has none, or has exited).
+bool all_threads_in(pid_t pid, char state) {
   bool any = false;
   std::error_code ec;
   for (const auto& task :
@@ -158,7 +158,7 @@ bool all_threads_sleep(pid_t pid) {
     if (!std::getline(stat, line)) return false;
     const auto name_end = line.rfind(')');  // "TID (comm) STATE ..."; comm may hold spaces
     if (name_end == std::string::npos || name_end + 2 >= line.size()) return false;
-    if (line[name_end + 2] != 'S') return false;
+    if (line[name_end + 2] != state) return false;
     any = true;
   }
   return any && !ec;
@@ -167,10 +167,12 @@ bool all_threads_sleep(pid_t pid) {
 }  // namespace
 
 bool idle(pid_t pid) {
-  if (!all_threads_sleep(pid)) return false;
+  if (!all_threads_in(pid, 'S')) return false;
   std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  return all_threads_sleep(pid);
+  return all_threads_in(pid, 'S');
 }
+
+bool stopped(pid_t pid) { return all_threads_in(pid, 'T'); }
 
 bool handled_bus(pid_t pid, int port) {
   return drained_bus(pid, port) && idle(pid) && drained_bus(pid, port);

@@ -64,6 +64,10 @@ bool drained_bus(pid_t pid, int port);
 /// runnable, none in disk wait), seen twice 20 ms apart.
 bool idle(pid_t pid);
 
+/// True when every thread of process `pid` is stopped (state T: SIGSTOP takes effect some time
+/// after kill() returns).
+bool stopped(pid_t pid);
+
 /// drained_bus() and idle(): `pid` has read what reached it and has handled it, nothing of it
 /// waits in a queue between its threads. lcm-logger needs this before it is stopped: on SIGINT its
 /// write thread exits at its next event and drops what is still queued for it (LCM 1.3.1's
