@@ -150,13 +150,16 @@ bool Bus::publish_raw(const std::string& channel, const void* data, int size) {
 
 void Bus::subscribe_raw(const std::string& channel_regex,
                         std::function<void(const RawMessage&)> handler, int queue) {
+  const std::string refused =
+      "cannot hold " + std::to_string(queue) + " messages for '" + channel_regex + "'";
+  if (queue < 1) throw BusError(refused);  // before subscribing: nothing is left half-made
   handlers_.push_back(std::make_unique<RawHandler>(*this, std::move(handler)));
   lcm::Subscription* subscription =
       lcm_->subscribe(channel_regex, &RawHandler::handleMessage, handlers_.back().get());
   if (subscription == nullptr) throw BusError("cannot subscribe to '" + channel_regex + "'");
-  if (queue < 1 || subscription->setQueueCapacity(queue) != 0) {
-    throw BusError("cannot hold " + std::to_string(queue) + " messages for '" + channel_regex +
-                   "'");
+  if (subscription->setQueueCapacity(queue) != 0) {
+    lcm_->unsubscribe(subscription);
+    throw BusError(refused);
   }
 }
 
