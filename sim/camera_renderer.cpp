@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <opencv2/imgproc.hpp>
 #include <random>
+
+#include "sim/box_from_eye.hpp"
 
 namespace sg::sim {
 namespace {
@@ -23,7 +26,16 @@ Eigen::Vector3d from_pixel(const cv::Vec3b& p) {
 /// Bilinear blend of the rays through a pixel's four corners, at (u, v) in [0, 1]^2.
 Eigen::Vector3d blend(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
                       const Eigen::Vector3d& d, double u, double v) {
-  return ((1 - v) * ((1 - u) * a + u * b) + v * ((1 - u) * c + u * d)).normalized();
+  // Component by component: the same arithmetic as Eigen's expression, without its temporaries
+  // (this runs for every ray the renderer casts).
+  double r[3];
+  for (int k = 0; k < 3; ++k) {
+    const double ab = (1 - u) * a[k] + u * b[k], cd = (1 - u) * c[k] + u * d[k];
+    r[k] = (1 - v) * ab + v * cd;
+  }
+  const double norm = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+  return norm > 0 ? Eigen::Vector3d(r[0] / norm, r[1] / norm, r[2] / norm)
+                  : Eigen::Vector3d(r[0], r[1], r[2]);
 }
 
 /// The corners of the cube around a sphere: their screen box holds the sphere's image.
@@ -155,6 +167,17 @@ struct CameraRenderer::Objects {
   Sphere ball;
   bool has_ball = false;
   const std::vector<Box>* boxes = nullptr;
+  /// The boxes as seen from the eye every ray starts at (prepare()).
+  std::vector<BoxFromEye> from_eye;
+
+  /// Call once `boxes` is set: every ray nearest() traces then starts at `eye`.
+  void prepare(const Eigen::Vector3d& eye, const Eigen::Vector3d& to_light) {
+    from_eye.clear();
+    for (size_t i = 0; boxes != nullptr && i < boxes->size(); ++i) {
+      from_eye.emplace_back((*boxes)[i], eye);
+      from_eye.back().shade_faces((*boxes)[i].material, to_light);
+    }
+  }
   /// Screen boxes of the ball ([0]) and of each box ([1..]); a ray through a point outside an
   /// object's screen box cannot hit it, so it is not tested.
   std::vector<cv::Rect> screen;
@@ -170,19 +193,25 @@ struct CameraRenderer::Objects {
     if (has_ball && may_hit(0, at)) {
       if (auto t = ball.intersect(ray)) hit = {0, *t};
     }
-    for (size_t i = 0; boxes != nullptr && i < boxes->size(); ++i) {
+    const double d[3] = {ray.direction.x(), ray.direction.y(), ray.direction.z()};
+    for (size_t i = 0; i < from_eye.size(); ++i) {
       if (!may_hit(i + 1, at)) continue;
-      if (auto t = (*boxes)[i].intersect(ray); t && *t < hit.distance) {
-        hit = {static_cast<int>(i) + 1, *t};
+      int face = -1;
+      if (const double t = from_eye[i].intersect(d, &face); t < hit.distance) {
+        hit = {static_cast<int>(i) + 1, t, face};
       }
     }
     return hit;
   }
 
   Eigen::Vector3d colour(const Hit& hit, const Ray& ray, const Eigen::Vector3d& to_light) const {
+    const size_t i = static_cast<size_t>(hit.object - 1);
+    if (hit.object > 0 && i < from_eye.size() && from_eye[i].flat && hit.face >= 0) {
+      return from_eye[i].face_colour[hit.face];
+    }
     const Eigen::Vector3d p = ray.origin + hit.distance * ray.direction;
     if (hit.object == 0) return shade(ball.material, ball.normal_at(p), ray.direction, to_light);
-    const Box& box = (*boxes)[static_cast<size_t>(hit.object - 1)];
+    const Box& box = (*boxes)[i];
     return shade(box.material, box.normal_at(p), ray.direction, to_light);
   }
 };
@@ -415,6 +444,7 @@ BallVisibility CameraRenderer::render(const DynamicScene& scene, cv::Mat& image)
   background_.copyTo(image);
   Objects objects;
   objects.boxes = &scene.boxes;
+  objects.prepare(eye_, to_light_);
   std::vector<cv::Rect> ball_screens;  // per ball centre; empty where it is not drawn
   std::vector<std::pair<cv::Rect, bool>> regions = screen_regions(scene, objects, ball_screens);
   merge_overlapping(regions);

@@ -70,6 +70,7 @@ class CameraRenderer {
   struct Hit {
     int object = -1;  // -1 nothing, 0 the ball, 1.. boxes
     double distance = 0.0;
+    int face = -1;  // boxes: which face (BoxFromEye::intersect)
   };
   struct Objects;
 
