@@ -90,7 +90,8 @@ void degrees(Section& section, const std::string& key, double& radians, const Ra
 
 void read_rig(const Config& config, RigParams& r) {
   Section c(config, "rig");
-  vector3(c, "target", r.target, Range::closed(-10, 10), "where the optical axes meet, robot frame (m)");
+  vector3(c, "target", r.target, Range::closed(-10, 10),
+          "where the optical axes meet, robot frame (m)");
   c.number("baseline", r.baseline, Range::above_to(0, 10), "m between the camera centres");
   degrees(c, "toe_in_deg", r.toe_in, Range::above_to(0, 89.9), "each camera turned inward");
   degrees(c, "pitch_deg", r.pitch, Range::closed(-90, 90), "the rig's elevation over the target");
@@ -117,8 +118,10 @@ void read_scenario(const Config& config, ScenarioParams& s) {
   vector3(c, "centre", s.centre, Range::closed(-10, 10), "m, robot frame");
   c.number("radius", s.radius, Range::closed(0, 10), "m (paper, circle, figure8)");
   c.number("rpm", s.rpm, Range::closed(-600, 600), "revolutions per minute");
-  degrees(c, "phase_deg", s.phase, Range::closed(-360, 360), "the starting phase (default: from the seed)");
-  c.number("drift_speed", s.drift_speed, Range::closed(0, 10), "paper: back-and-forth along Y (m/s)");
+  degrees(c, "phase_deg", s.phase, Range::closed(-360, 360),
+          "the starting phase (default: from the seed)");
+  c.number("drift_speed", s.drift_speed, Range::closed(0, 10),
+           "paper: back-and-forth along Y (m/s)");
   c.number("drift_half_period", s.drift_half_period, Range::above_to(0, 86400),
            "s between the drift's reversals");
   vector3(c, "line_direction", s.line_direction, Range::closed(-1e3, 1e3), "line: its direction");
@@ -170,6 +173,8 @@ void read_lighting(const Config& config, LightingParams& l) {
 void read_camera_sim(const Config& config, SimParams& p) {
   Section c(config, "camera_sim");
   c.number("rate_hz", p.frame_rate, Range::above_to(0, 1000), "frames per second");
+  c.number("max_lag", p.max_lag, Range::closed(0, 3600),
+           "s: real time, frames later than this are dropped (0: never)");
   c.choice("encoding", p.encoding, {"jpeg", "raw"}, "image_t encoding on the bus");
   c.number("ball_radius", p.ball_radius, Range::above_to(0, 1), "m");
   c.number("noise_sigma", p.noise_sigma, Range::closed(0, 255), "sensor noise, grey levels");

@@ -33,6 +33,7 @@ struct SimParams {
   double exposure = 0.0;       ///< s; > 0 with motion_blur_samples > 1 blurs the ball
   int motion_blur_samples = 1;
   double frame_rate = 30.0;      ///< Hz
+  double max_lag = 0.2;          ///< s: real time, a frame later than this is dropped (FramePacing)
   double min_visible_px = 10.0;  ///< a camera "sees" the ball when this much of it shows
   std::string encoding = "jpeg";  ///< image_t encoding sg-camera-sim publishes: jpeg or raw
 };

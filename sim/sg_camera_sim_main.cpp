@@ -23,6 +23,7 @@
 #include "common/program.hpp"
 #include "common/shutdown.hpp"
 #include "sim/camera_simulator.hpp"
+#include "sim/frame_pacing.hpp"
 #include "vision/calibration_file.hpp"
 #include "vision/image_message.hpp"
 
@@ -139,9 +140,21 @@ int run_bus(sg::sim::CameraSimulator& sim, const Options& o, int64_t frames, boo
   spdlog::info("publishing CAMERA_LEFT, CAMERA_RIGHT, GROUND_TRUTH at {} Hz ({}{})", rate,
                jpeg ? "JPEG" : "raw BGR", o.fast ? ", as fast as possible" : "");
   sg::sim::StereoFrame frame;
-  int64_t k = 0;
+  sg::sim::FramePacing pacing(period_us, o.fast ? 0 : std::llround(sim.params().max_lag * 1e6));
+  int64_t k = 0, published = 0;
   for (; (frames == 0 || k < frames) && !sg::shutdown_requested(); ++k) {
-    if (!o.fast) std::this_thread::sleep_until(start + microseconds(k * period_us));
+    if (!o.fast) {
+      std::this_thread::sleep_until(start + microseconds(k * period_us));
+      const int64_t late = pacing.skipped();
+      k = pacing.next_frame(k, duration_cast<microseconds>(steady_clock::now() - start).count(),
+                            frames);
+      if (late == 0 && pacing.skipped() > 0)
+        spdlog::warn(
+            "rendering cannot keep {} Hz: dropping frames later than {} s, as a camera "
+            "would (camera_sim.max_lag)",
+            rate, sim.params().max_lag);
+      if (frames != 0 && k >= frames) break;
+    }
     while (bus.handle(milliseconds(0))) {
     }
     // Capture time: the frame's place on the timeline (real time, or simulated with --fast).
@@ -153,10 +166,12 @@ int run_bus(sg::sim::CameraSimulator& sim, const Options& o, int64_t frames, boo
                 sg::vision::encode_image(frame.image[1], stereograsp::image_t::RIGHT, k, utime,
                                          jpeg, o.jpeg_quality));
     bus.publish("GROUND_TRUTH", ground_truth(frame, utime));
+    ++published;
   }
   const double seconds = duration<double>(steady_clock::now() - start).count();
-  std::printf("published %lld stereo frames in %.2f s (%.1f per second)\n",
-              static_cast<long long>(k), seconds, k / std::max(seconds, 1e-9));
+  std::printf("published %lld stereo frames in %.2f s (%.1f per second), dropped %lld late\n",
+              static_cast<long long>(published), seconds, published / std::max(seconds, 1e-9),
+              static_cast<long long>(pacing.skipped()));
   return bus.publish_errors() == 0 ? 0 : 1;
 }
 
@@ -170,6 +185,7 @@ int main(int argc, char** argv) {
   Options o;
   const auto keys = sg::declared_keys(sg::sim::load_sim_params);
   common.flags.add(app, "--rate", "camera_sim.rate_hz", keys);
+  common.flags.add(app, "--max-lag", "camera_sim.max_lag", keys);
   app.add_flag("--fast", o.fast,
                "render as fast as possible (simulated time) instead of real time");
   app.add_option("--frames", o.frames, "stop after this many stereo frames (0: until Ctrl-C)");

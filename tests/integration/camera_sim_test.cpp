@@ -2,15 +2,18 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 #include <thread>
 
 #include "common/bus.hpp"
+#include "common/clock.hpp"
 #include "common/message_types.hpp"
 #include "tests/integration/multicast_guard.hpp"
 #include "tests/support/subprocess.hpp"
+#include "tests/support/wait.hpp"
 #include "vision/calibration_file.hpp"
 
 namespace sg::test {
@@ -57,6 +60,50 @@ TEST(CameraSim, PublishesFramesAndTruthOnTheBus) {
   const cv::Mat decoded = cv::imdecode(left[3].data, cv::IMREAD_COLOR);
   EXPECT_EQ(decoded.cols, 640);
   EXPECT_EQ(decoded.rows, 480);
+}
+
+// Asked for more frames a second than it can render (1000 Hz), the simulator drops the late ones
+// as a camera would: the frames it publishes are on the 1 ms timeline, each stamped with its own
+// slot, none far behind the clock, and published plus dropped is the whole timeline.
+TEST(CameraSim, DropsFramesItCannotRenderInTime) {
+  constexpr int kPort = 7977;
+  ASSERT_TRUE(multicast_available(kPort));
+  Bus bus(test_url(kPort));
+  std::vector<std::pair<stereograsp::image_t, int64_t>> left;  // with the receive time
+  bus.subscribe<stereograsp::image_t>("CAMERA_LEFT", [&](const auto& m, const ReceiveInfo& info) {
+    left.emplace_back(m, info.recv_utime);
+  });
+  const int64_t started = now_utime();
+  Child sim({program("sg-camera-sim"), "--rate", "1000", "--frames", "300", "--max-lag", "0.005",
+             "--lcm-url", test_url(kPort)});
+  ASSERT_TRUE(eventually(
+      bus, [&] { return !sim.running(); }, 60s, "sg-camera-sim to end its 0.3 s timeline"));
+  while (bus.handle(200ms)) {
+  }
+  const ProcessResult done = sim.wait(10s);
+  ASSERT_EQ(done.exit_code, 0) << done.err;
+  long long published = -1, dropped = -1;
+  const size_t at = done.out.find("published ");
+  ASSERT_NE(at, std::string::npos) << done.out;
+  ASSERT_EQ(std::sscanf(done.out.c_str() + at,
+                        "published %lld stereo frames in %*f s (%*f per "
+                        "second), dropped %lld late",
+                        &published, &dropped),
+            2)
+      << done.out;
+  EXPECT_GT(dropped, 0) << done.out;
+  EXPECT_EQ(published + dropped, 300) << done.out;
+  ASSERT_GT(left.size(), 1u);
+  EXPECT_LE(static_cast<long long>(left.size()), published);
+  for (size_t k = 1; k < left.size(); ++k) {
+    const auto& [m, recv] = left[k];
+    EXPECT_GT(m.frame_number, left[k - 1].first.frame_number);
+    EXPECT_EQ(m.utime - left[0].first.utime, (m.frame_number - left[0].first.frame_number) * 1000);
+    // Rendering every frame, the last would be published about 300 renders - 0.3 s late (0.9 s
+    // in Release, 6 s under sanitizers); dropping, at most max_lag + one render.
+    EXPECT_LT(recv - m.utime, 250'000) << "frame " << m.frame_number << " published late";
+  }
+  EXPECT_GT(left.front().first.utime, started);
 }
 
 // The gripper's state on SIM_ARM_STATE reaches the simulator: a ball held by the gripper is where
