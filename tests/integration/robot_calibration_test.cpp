@@ -14,7 +14,9 @@
 #include <filesystem>
 
 #include "arm_driver/kinematics.hpp"
+#include "common/bus.hpp"
 #include "common/config.hpp"
+#include "common/message_types.hpp"
 #include "tests/integration/multicast_guard.hpp"
 #include "tests/support/subprocess.hpp"
 #include "tests/support/wait.hpp"
@@ -90,6 +92,24 @@ TEST(RobotCalibrationProcesses, CalibratesTheSimulatedCamerasInTheRobotFrame) {
   Child cameras(
       {program("sg-camera-sim"), "--lcm-url", url, "--calibration-out", dir + "/truth.yaml"});
   Child vision_process({program("sg-vision"), "--lcm-url", url});
+  // Start once the cameras film the arm: a camera that has not yet heard SIM_ARM_STATE draws the
+  // ball on its own path, and a slow start (the sanitized build's takes 6 s) gave the first
+  // stop blobs from there, 0.31 m from the tool.
+  {
+    Bus bus(url);
+    Eigen::Vector3d tool(NAN, NAN, NAN);
+    bool filming_the_arm = false;
+    bus.subscribe<stereograsp::sim_arm_state_t>("SIM_ARM_STATE", [&](const auto& m, const auto&) {
+      tool = Eigen::Vector3d(m.tool_position[0], m.tool_position[1], m.tool_position[2]);
+    });
+    bus.subscribe<stereograsp::point3_t>("GROUND_TRUTH", [&](const auto& m, const auto&) {
+      const Eigen::Vector3d ball(m.position[0], m.position[1], m.position[2]);
+      filming_the_arm |= (ball - tool).norm() < 1e-6;  // the ball in the gripper
+    });
+    ASSERT_TRUE(eventually(
+        bus, [&] { return filming_the_arm; }, 120s,
+        "sg-camera-sim to film the ball in the gripper"));
+  }
   const auto start = std::chrono::steady_clock::now();
   const ProcessResult r = run({program("sg-calibrate"), "--lcm-url", url, "robot", "--out",
                                dir + "/cams.yaml", "--timeout", "30"},
