@@ -10,8 +10,7 @@
 #                                            starts, fails the run (docs/fuzzing.md)
 #                                            SG_SANITIZE_BUILD: another build folder;
 #                                            SG_SANITIZE_TARGETS: only those targets and their
-#                                            tests; SG_SANITIZE_REALTIME=1: also the tests
-#                                            labelled realtime (left out by default)
+#                                            tests
 #
 # The tests run in a private network namespace (scripts/multicast.sh run), so their multicast
 # never leaves the machine and never meets a running system's bus.
@@ -51,21 +50,9 @@ export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1:detect_stack_use_after_retur
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1:log_path=$reports/ubsan"
 export LSAN_OPTIONS="suppressions=$supp/lsan.supp:print_suppressions=0"
 
-# The closed-loop tests labelled realtime need the Release build's speed, and the image path
-# under ASan + UBSan is about 6 times slower: they are left out unless SG_SANITIZE_REALTIME=1.
-realtime=(-LE realtime)
-if [ "${SG_SANITIZE_REALTIME:-0}" = 1 ]; then
-  realtime=()
-else
-  # (-FA: without the fixtures ctest would add to them)
-  left_out=$(ctest --test-dir "$build" -N -L realtime -FA ".*" | sed -n 's/^ *Test *#[0-9]*: //p')
-  echo "test.sh --sanitize: leaving out the tests labelled realtime (SG_SANITIZE_REALTIME=1 runs" \
-    "them):" $left_out
-fi
-
 status=0
 scripts/multicast.sh run ctest --test-dir "$build" --output-on-failure -j "$jobs" "${skip[@]}" \
-  "${realtime[@]}" "$@" || status=$?
+  "$@" || status=$?
 
 if compgen -G "$reports/*" >/dev/null; then
   echo "test.sh --sanitize: sanitizer reports:" >&2
