@@ -108,6 +108,54 @@ TEST(LogReader, CleanLogReadsEveryEvent) {
   EXPECT_EQ(reader.position(), size);
 }
 
+/// An event header and body as lcm-logger's format has them, written byte by byte (LCM's own
+/// writer takes the channel as a C string, so it cannot write a NUL inside one).
+std::vector<uint8_t> raw_event(int64_t number, int64_t utime, const std::string& channel,
+                               const std::vector<uint8_t>& data) {
+  std::vector<uint8_t> out;
+  auto put = [&](uint64_t v, int bytes) {
+    for (int i = bytes - 1; i >= 0; --i) out.push_back(static_cast<uint8_t>(v >> (8 * i)));
+  };
+  put(0xEDA1DA01u, 4);
+  put(static_cast<uint64_t>(number), 8);
+  put(static_cast<uint64_t>(utime), 8);
+  put(channel.size(), 4);
+  put(data.size(), 4);
+  out.insert(out.end(), channel.begin(), channel.end());
+  out.insert(out.end(), data.begin(), data.end());
+  return out;
+}
+
+// A channel holding a NUL byte (LCM's reader returns it cut at the NUL) is handed out whole, as
+// it is on disk, and the events after it are at their offsets, with no problem reported.
+TEST(LogReader, ChannelWithANulIsReadAsOnDisk) {
+  const std::string path = test::make_temp_dir() + "/nul.lcmlog";
+  const std::string nul_channel("BAD\0CHANNEL", 11);
+  std::vector<uint8_t> bytes;
+  for (int i = 0; i < 3; ++i) {
+    const auto e = raw_event(i, kFive[static_cast<size_t>(i)], i == 1 ? nul_channel : "POS",
+                             position_bytes(i));
+    bytes.insert(bytes.end(), e.begin(), e.end());
+  }
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes.data()),
+             static_cast<std::streamsize>(bytes.size()));
+  LogReader reader(path);
+  LogRecord e;
+  std::vector<std::string> channels;
+  std::vector<int64_t> offsets;
+  while (reader.next(e)) {
+    channels.push_back(e.channel);
+    offsets.push_back(e.offset);
+    EXPECT_EQ(std::vector<uint8_t>(e.data, e.data + e.size), position_bytes(e.event_number));
+  }
+  const int64_t pos = 28 + 3 + static_cast<int64_t>(position_bytes(0).size());
+  EXPECT_EQ(channels, (std::vector<std::string>{"POS", nul_channel, "POS"}));
+  EXPECT_EQ(offsets, (std::vector<int64_t>{0, pos, pos + 8 + pos}));
+  EXPECT_TRUE(reader.problems().empty());
+  EXPECT_EQ(reader.position(), static_cast<int64_t>(bytes.size()));
+}
+
 // A log cut in the middle of its last event: the others are read, and the cut is named.
 TEST(LogReader, TruncatedMidEventIsReported) {
   const std::string path = test::make_temp_dir() + "/cut.lcmlog";
