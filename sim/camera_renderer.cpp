@@ -187,6 +187,8 @@ struct CameraRenderer::Objects {
     return at.x >= r.x && at.y >= r.y && at.x <= r.x + r.width && at.y <= r.y + r.height;
   }
 
+  /// The first object `ray` hits; the ray starts at the eye prepare() was given (every ray the
+  /// renderer casts starts at the camera centre).
   Hit nearest(const Ray& ray, const cv::Point2f& at) const {
     Hit hit;
     hit.distance = std::numeric_limits<double>::infinity();
