@@ -93,6 +93,11 @@ void fill(blob_t& m, Pattern& p) {
   p.fill(m.search_window);
   m.num_regions = p.below(100);
   m.misses = p.below(100);
+  p.fill(m.centre);
+  m.radius = p.real();
+  m.fit_support = p.real();
+  m.confidence = p.real();
+  m.candidates = p.below(100);
 }
 void fill(point3_t& m, Pattern& p) {
   m.visible = p.flag();

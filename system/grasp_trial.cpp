@@ -136,7 +136,8 @@ Trial::Trial(const TrialParams& p)
       line_(emulator_, clock_,
             {p.baud, [this](double t) { emulator_.set_ball_centre(ball_at(t)); }}),
       driver_(p.arm, p.driver, [this] { return line_.connect(); }, clock_),
-      vision_(p.tracker, cv::Size(p.sim.rig.width, p.sim.rig.height), true_calibration(cameras_)),
+      vision_(p.tracker, cv::Size(p.sim.rig.width, p.sim.rig.height), true_calibration(cameras_),
+              vision::StereoMatchParams{.ball_radius = p.sim.ball_radius}),
       predictor_(p.predictor),
       node_(p.arm, p.grasp, kTrialEpochUtime, 1.0 / p.grasp_status_rate),
       arm_status_rule_(1.0 / p.arm_status_rate) {
@@ -168,8 +169,10 @@ point3_t Trial::model_camera(double t, const Eigen::Vector3d& truth) {
   for (size_t i = 0; i < 2; ++i) {
     const auto px = cameras_[i].project(truth);
     o[i].found = px && !sim::fully_occluded_at(p_.sim.occlusion, t);
-    if (o[i].found)
+    if (o[i].found) {
       o[i].blob.centroid = {px->x() + noise(noise_rng_), px->y() + noise(noise_rng_)};
+      o[i].centre = o[i].blob.centroid;
+    }
   }
   return vision::position_of(o, *vision_.calibration(), clock_.utime_at(t));
 }
@@ -317,6 +320,7 @@ TrialResult Trial::finish() {
   }
   result_.serial_bytes = line_.bytes_written();
   if (vision_n_ > 0) result_.vision_rms = std::sqrt(vision_sq_ / vision_n_);
+  result_.vision_samples = static_cast<int64_t>(vision_n_);
   return result_;
 }
 

@@ -99,6 +99,7 @@ struct TrialResult {
   int interactions = 0;              ///< motion lines the controller received (MA, READY, ...)
   uint64_t serial_bytes = 0;         ///< bytes the driver wrote on the line
   double vision_rms = std::nan("");  ///< m: 3D RMS of the measurements against the truth
+  int64_t vision_samples = 0;        ///< visible measurements vision_rms is over
                                      ///< (visible frames, ball not carried)
 };
 

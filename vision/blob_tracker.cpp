@@ -23,10 +23,25 @@ cv::Rect search_window(const cv::Point2d& centre, double diameter, int misses, c
   return window & whole;
 }
 
+namespace {
+
+/// A whole disc's moments give equal axes (eq. 16-17), and it fills pi / 4 of a square box.
+/// (A disc with a small cap hidden already has l / w above 1.08: 0.93 of it visible gives 1.1.)
+bool looks_like_a_whole_disc(const Blob& b, const Region& region) {
+  const cv::Rect box = region.box();
+  if (b.minor_axis <= 0 || box.width < 4 || box.height < 4) return false;
+  const double fill = b.area / box.area(), aspect = double(box.width) / box.height;
+  return b.major_axis / b.minor_axis < 1.08 && std::abs(fill - M_PI / 4) < 0.05 &&
+         std::abs(aspect - 1) < 0.1;
+}
+
+}  // namespace
+
 BlobTracker::BlobTracker(const Params& params, cv::Size image_size)
     : params_(params), size_(image_size), detector_(params.color), segmenter_(image_size) {
   if (image_size.width <= 0 || image_size.height <= 0)
     throw std::invalid_argument("BlobTracker: image size must be positive");
+  edge_.reserve(8192);
 }
 
 void BlobTracker::reset() {
@@ -35,10 +50,74 @@ void BlobTracker::reset() {
 }
 
 Observation BlobTracker::track(const cv::Mat& bgr, const std::optional<cv::Point2d>& predicted) {
+  const Detection d = detect(bgr, predicted);
+  return accept(d, d.best);
+}
+
+ScoreContext BlobTracker::context(const std::optional<cv::Point2d>& predicted,
+                                  const std::optional<double>& expected_radius) const {
+  ScoreContext x;
+  if (has_track_) {
+    x.expected_centre = predicted.value_or(last_centre_);
+    x.motion_sigma =
+        params_.scoring.motion_scale * std::max(last_diameter_, 10.0) * (1 + misses_);
+  }
+  if (expected_radius) {
+    x.expected_radius = expected_radius;
+  } else if (has_track_ && misses_ < params_.forget_size_after_misses) {
+    x.expected_radius = last_diameter_ / 2;
+  }
+  x.colour = colour_.estimate();
+  return x;
+}
+
+Candidate BlobTracker::describe(const Region& region) {
+  Candidate c;
+  c.blob = blob_from_moments(region.moments);
+  c.centre = c.blob.centroid;
+  c.radius = std::sqrt(c.blob.area / M_PI);
+  c.mean_r = region.mean_r(), c.mean_g = region.mean_g();
+  if (params_.selection == Selection::kLargest) {
+    c.radius = c.blob.major_axis / 2;
+    return c;
+  }
+  for (const Clutter& k : clutter_) {
+    c.clutter |= k.frames >= params_.clutter_frames &&
+                 cv::norm(k.centre - c.blob.centroid) <= params_.clutter_distance &&
+                 std::abs(std::log(c.blob.area / k.area)) < 0.2;
+  }
+  if (c.radius > params_.scoring.max_radius) {
+    c.too_large = true;
+    return c;
+  }
+  if (looks_like_a_whole_disc(c.blob, region)) {
+    c.whole_disc = true;
+    return c;
+  }
+  edge_.clear();
+  const cv::Mat mask = segmenter_.mask_of(region);
+  append_edge_points(mask, segmenter_.mask_origin(), segmenter_.window(), edge_);
+  const BallFit fit = fitter_.fit(edge_, params_.fit);
+  if (!fit.ok) {
+    c.support = 0;
+    return c;
+  }
+  c.fitted = fit.support < params_.scoring.fit_below_support;
+  if (c.fitted) c.centre = fit.centre;
+  c.radius = fit.radius;
+  c.support = fit.support;
+  c.fit_rms = fit.rms;
+  return c;
+}
+
+Detection BlobTracker::detect(const cv::Mat& bgr, const std::optional<cv::Point2d>& predicted,
+                              const std::optional<double>& expected_radius) {
   if (bgr.type() != CV_8UC3 || bgr.size() != size_)
     throw std::invalid_argument("BlobTracker: expected a " + std::to_string(size_.width) + "x" +
                                 std::to_string(size_.height) + " BGR image");
-  Observation o;
+  ++frame_;
+  Detection d;
+  Observation& o = d.frame;
   o.misses = misses_;
   o.tracking = has_track_ && misses_ < params_.window.misses_before_full_frame;
   o.window = o.tracking ? search_window(predicted.value_or(last_centre_), last_diameter_, misses_,
@@ -54,17 +133,67 @@ Observation BlobTracker::track(const cv::Mat& bgr, const std::optional<cv::Point
   }
   const Segmentation s = segmenter_.run(bgr, o.window, detector_, min_area);
   o.num_regions = s.num_regions;
-  o.found = s.found;
-  if (s.found) {
-    o.blob = blob_from_moments(s.largest);
-    has_track_ = true;
-    last_centre_ = o.blob.centroid;
-    last_diameter_ = o.blob.major_axis;
-    last_area_ = o.blob.area;
-    misses_ = 0;
-  } else if (has_track_) {
-    ++misses_;
+  ScoreContext x = context(predicted, expected_radius);
+  if (s.num_candidates > 0) x.largest_area = static_cast<double>(s.regions[0].moments.m00);
+  double best = params_.scoring.max_cost;
+  for (int k = 0; k < s.num_candidates; ++k) {
+    Candidate& c = d.candidates[static_cast<size_t>(k)];
+    c = describe(s.regions[static_cast<size_t>(k)]);
+    ++d.count;
+    if (params_.selection == Selection::kLargest) break;  // the largest is the target
+    c.cost = candidate_cost(c, x, params_.scoring);
+    if (c.cost <= best) best = c.cost, d.best = k;
   }
+  if (params_.selection == Selection::kLargest && d.count > 0) d.best = 0;
+  o.candidates = d.count;
+  return d;
+}
+
+// Regions other than the ball, far from it, that stay put frame after frame are background.
+void BlobTracker::learn_clutter(const Detection& d, int index) {
+  if (params_.clutter_frames <= 0) return;
+  const Candidate& ball = d.candidates[static_cast<size_t>(index)];
+  for (int k = 0; k < d.count; ++k) {
+    const Candidate& c = d.candidates[static_cast<size_t>(k)];
+    if (k == index || cv::norm(c.blob.centroid - ball.centre) < 3 * 2 * ball.radius) continue;
+    Clutter* slot = &clutter_[0];
+    bool matched = false;
+    for (Clutter& e : clutter_) {
+      if (e.frames > 0 && cv::norm(e.centre - c.blob.centroid) <= params_.clutter_distance &&
+          std::abs(std::log(c.blob.area / e.area)) < 0.2) {
+        slot = &e, matched = true;
+        break;
+      }
+      if (e.last_seen < slot->last_seen) slot = &e;  // else the longest unseen is replaced
+    }
+    if (!matched) *slot = Clutter{c.blob.centroid, c.blob.area, 0, 0};
+    ++slot->frames;
+    slot->last_seen = frame_;
+  }
+}
+
+Observation BlobTracker::accept(const Detection& d, int index) {
+  Observation o = d.frame;
+  if (index < 0 || index >= d.count) {
+    if (has_track_) ++misses_;
+    return o;
+  }
+  const Candidate& c = d.candidates[static_cast<size_t>(index)];
+  o.found = true;
+  o.blob = c.blob;
+  o.centre = c.centre;
+  o.radius = c.radius;
+  o.fit_support = c.support;
+  o.confidence = params_.selection == Selection::kLargest ? 1.0 : std::exp(-c.cost / 4);
+  if (params_.selection == Selection::kScored) {
+    learn_clutter(d, index);
+    if (o.confidence >= 0.5 && c.support >= 0.8) colour_.add(c.mean_r, c.mean_g);
+  }
+  has_track_ = true;
+  last_centre_ = c.centre;
+  last_diameter_ = 2 * c.radius;
+  last_area_ = c.blob.area;
+  misses_ = 0;
   return o;
 }
 

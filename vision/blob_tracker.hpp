@@ -3,7 +3,14 @@
 #include <opencv2/core.hpp>
 #include <optional>
 
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include "vision/ball_fit.hpp"
+#include "vision/ball_score.hpp"
 #include "vision/color_detector.hpp"
+#include "vision/color_model.hpp"
 #include "vision/moments.hpp"
 #include "vision/segmentation.hpp"
 
@@ -31,17 +38,41 @@ cv::Rect search_window(const cv::Point2d& centre, double diameter, int misses, c
 struct Observation {
   bool found = false;
   bool tracking = false;  ///< true: only the search window was processed
-  Blob blob;              ///< valid when found
+  Blob blob;              ///< valid when found: the chosen region's eq. 11-22
+  cv::Point2d centre;     ///< the ball's centre: fitted circle when partly hidden, else centroid
+  double radius = 0;      ///< px, of the ball's image
+  double fit_support = std::nan("");  ///< of the fitted circle's circumference (NaN: no fit)
+  double confidence = 0;  ///< 0..1, exp(-cost / 4) of the chosen candidate
+  int candidates = 0;     ///< regions of at least the minimum area that were scored
   cv::Rect window;        ///< the window processed (the whole image when not tracking)
   int num_regions = 0;    ///< regions of the object's colour in the window
   int misses = 0;         ///< consecutive misses before this frame
 };
 
-/// Detection, segmentation and moment tracking of one camera (sections 5.1-5.3).
+/// How the tracker picks the ball among the regions of its colour.
+enum class Selection {
+  kLargest,  ///< the paper's rule (section 5.2): the largest region, its centroid (eq. 11)
+  kScored,   ///< the lowest candidate_cost() (ball_score.hpp), a fitted centre when partly hidden
+};
+
+/// One frame's candidates, before one is accepted as the ball.
+struct Detection {
+  Observation frame;  ///< window, mode, regions, misses; found false
+  std::array<Candidate, Segmentation::kMaxRegions> candidates;
+  int count = 0;
+  int best = -1;  ///< the candidate the camera alone would take (-1: none)
+};
+
+/// Detection, segmentation and moment tracking of one camera (sections 5.1-5.3), with the ball
+/// chosen among the regions of its colour by a score (ball_score.hpp) or by the paper's
+/// largest-region rule.
 ///
 ///     BlobTracker left(params, {640, 480});
 ///     Observation o = left.track(frame);                 // or track(frame, predicted_pixel)
-///     if (o.found) draw_cross(o.blob.centroid);
+///     if (o.found) draw_cross(o.centre);
+///
+/// A stereo caller splits the step: detect() in both cameras, choose a pair that agrees
+/// (stereo_match.hpp), accept() it in each.
 class BlobTracker {
  public:
   struct Params {
@@ -53,6 +84,13 @@ class BlobTracker {
     double min_area_fraction_of_last = 0.2;
     /// Misses after which the ball's last size is forgotten (it may come back at any size).
     int forget_size_after_misses = 150;
+    Selection selection = Selection::kScored;
+    ScoringParams scoring;
+    BallFitParams fit;
+    /// A region that stays within `clutter_distance` px and keeps its size for this many frames
+    /// while the ball is tracked elsewhere is learned as background (0: never).
+    int clutter_frames = 30;
+    double clutter_distance = 2.0;
   };
 
   BlobTracker(const Params& params, cv::Size image_size);
@@ -60,16 +98,43 @@ class BlobTracker {
   /// Processes one frame (CV_8UC3 BGR of the size given at construction).
   Observation track(const cv::Mat& bgr, const std::optional<cv::Point2d>& predicted = std::nullopt);
 
+  /// The candidates of one frame, scored; `expected_radius` (px, from the ball's depth) replaces
+  /// the last image's size in the score.
+  Detection detect(const cv::Mat& bgr, const std::optional<cv::Point2d>& predicted = std::nullopt,
+                   const std::optional<double>& expected_radius = std::nullopt);
+  /// Takes candidate `index` of `d` as the ball (-1: a miss) and updates the track.
+  Observation accept(const Detection& d, int index);
+
   /// Forgets the track: the next frame is searched whole.
   void reset();
 
   const Params& params() const { return params_; }
+  bool has_track() const { return has_track_; }
+  /// The learned colour (ColorModel), for a report.
+  const ColorModel& colour() const { return colour_; }
 
  private:
+  Candidate describe(const Region& region);
+  ScoreContext context(const std::optional<cv::Point2d>& predicted,
+                       const std::optional<double>& expected_radius) const;
+  void learn_clutter(const Detection& d, int index);
+
+  struct Clutter {
+    cv::Point2d centre;
+    double area = 0;
+    int frames = 0;
+    int64_t last_seen = 0;
+  };
+
   Params params_;
   cv::Size size_;
   ColorDetector detector_;
   Segmenter segmenter_;
+  BallFitter fitter_;
+  std::vector<cv::Point2d> edge_;
+  ColorModel colour_;
+  std::array<Clutter, 16> clutter_{};
+  int64_t frame_ = 0;
   bool has_track_ = false;
   cv::Point2d last_centre_;
   double last_diameter_ = 0;

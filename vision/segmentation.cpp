@@ -9,6 +9,7 @@ Segmenter::Segmenter(cv::Size max_size) {
   labels_.resize(pixels);
   parent_.resize(pixels / 2 + 2);  // 8-connectivity: at most one new label every other pixel
   sums_.resize(pixels / 2 + 2);
+  mask_.resize(static_cast<size_t>((max_size.width + 2) * (max_size.height + 2)));
 }
 
 int32_t Segmenter::find(int32_t label) {
@@ -28,17 +29,34 @@ int32_t Segmenter::unite(int32_t a, int32_t b) {
   return b;
 }
 
-Segmentation Segmenter::run(const cv::Mat& bgr, const cv::Rect& window,
-                            const ColorDetector& detector, int min_area) {
-  CV_Assert(bgr.type() == CV_8UC3);
-  const cv::Rect w = window & cv::Rect(0, 0, bgr.cols, bgr.rows);
-  if (static_cast<size_t>(w.area()) > labels_.size())
-    throw std::invalid_argument("Segmenter: window larger than the size it was made for");
-  const int ww = w.width, wh = w.height;
-  int32_t next = 1;
+namespace {
+
+void add_pixel(Region& r, int x, int y, const uint8_t* bgr) {
+  r.moments.add(x, y);
+  r.x_min = std::min(r.x_min, x), r.x_max = std::max(r.x_max, x);
+  r.y_min = std::min(r.y_min, y), r.y_max = y;  // rows come in order
+  r.sum_b += bgr[0], r.sum_g += bgr[1], r.sum_r += bgr[2];
+}
+
+void merge(Region& into, const Region& r) {
+  RawMoments& m = into.moments;
+  m.m00 += r.moments.m00, m.m10 += r.moments.m10, m.m01 += r.moments.m01;
+  m.m20 += r.moments.m20, m.m02 += r.moments.m02, m.m11 += r.moments.m11;
+  into.x_min = std::min(into.x_min, r.x_min), into.x_max = std::max(into.x_max, r.x_max);
+  into.y_min = std::min(into.y_min, r.y_min), into.y_max = std::max(into.y_max, r.y_max);
+  into.sum_b += r.sum_b, into.sum_g += r.sum_g, into.sum_r += r.sum_r;
+}
+
+}  // namespace
+
+// One pass: detect and label (a pixel joins its already-labelled 8-neighbours above and left),
+// summing moments, extent and colour per provisional label as it goes.
+void Segmenter::label_window(const cv::Mat& bgr, const ColorDetector& detector) {
+  const cv::Rect& w = window_;
+  const int ww = w.width;
+  next_ = 1;
   parent_[0] = 0;
-  // Pass 1: detect and label; a pixel joins its already-labelled 8-neighbours above and left.
-  for (int y = 0; y < wh; ++y) {
+  for (int y = 0; y < w.height; ++y) {
     const uint8_t* in = bgr.ptr<uint8_t>(w.y + y) + 3 * w.x;
     int32_t* row = labels_.data() + static_cast<size_t>(y) * ww;
     const int32_t* up = y > 0 ? row - ww : nullptr;
@@ -56,31 +74,74 @@ Segmentation Segmenter::run(const cv::Mat& bgr, const cv::Rect& window,
         }
       }
       if (label == 0) {
-        label = next++;
+        label = next_++;
         parent_[static_cast<size_t>(label)] = label;
+        sums_[static_cast<size_t>(label)] = Region{{}, w.x + x, w.y + y, w.x + x, w.y + y, 0, 0, 0, label};
       }
       row[x] = label;
+      add_pixel(sums_[static_cast<size_t>(label)], w.x + x, w.y + y, in);
     }
   }
-  // Pass 2: moments per region (image coordinates), counted at each region's root.
-  for (int32_t i = 1; i < next; ++i) sums_[static_cast<size_t>(i)] = RawMoments{};
-  for (int y = 0; y < wh; ++y) {
-    const int32_t* row = labels_.data() + static_cast<size_t>(y) * ww;
-    for (int x = 0; x < ww; ++x) {
-      if (row[x] != 0) sums_[static_cast<size_t>(find(row[x]))].add(w.x + x, w.y + y);
-    }
+}
+
+// A label's parent is never larger than itself, so one forward pass points each at its root;
+// each provisional label's sums then go to its root.
+void Segmenter::sum_regions() {
+  for (int32_t i = 1; i < next_; ++i) {
+    const size_t p = static_cast<size_t>(parent_[static_cast<size_t>(parent_[static_cast<size_t>(i)])]);
+    parent_[static_cast<size_t>(i)] = static_cast<int32_t>(p);
+    if (p != static_cast<size_t>(i)) merge(sums_[p], sums_[static_cast<size_t>(i)]);
   }
+}
+
+// Keeps `region` among the kMaxRegions largest, largest first.
+void Segmenter::keep_candidate(Segmentation& s, const Region& region) const {
+  int at = s.num_candidates;
+  while (at > 0 && s.regions[static_cast<size_t>(at - 1)].moments.m00 < region.moments.m00) --at;
+  if (at >= Segmentation::kMaxRegions) return;
+  const int last = std::min(s.num_candidates, Segmentation::kMaxRegions - 1);
+  for (int k = last; k > at; --k) s.regions[static_cast<size_t>(k)] = s.regions[static_cast<size_t>(k - 1)];
+  s.regions[static_cast<size_t>(at)] = region;
+  s.num_candidates = std::min(s.num_candidates + 1, Segmentation::kMaxRegions);
+}
+
+Segmentation Segmenter::run(const cv::Mat& bgr, const cv::Rect& window,
+                            const ColorDetector& detector, int min_area) {
+  CV_Assert(bgr.type() == CV_8UC3);
+  window_ = window & cv::Rect(0, 0, bgr.cols, bgr.rows);
+  if (static_cast<size_t>(window_.area()) > labels_.size())
+    throw std::invalid_argument("Segmenter: window larger than the size it was made for");
+  label_window(bgr, detector);
+  sum_regions();
   Segmentation result;
-  for (int32_t i = 1; i < next; ++i) {
+  for (int32_t i = 1; i < next_; ++i) {
     if (parent_[static_cast<size_t>(i)] != i) continue;
     ++result.num_regions;
-    const RawMoments& m = sums_[static_cast<size_t>(i)];
-    if (m.m00 >= min_area && m.m00 > result.largest.m00) {
-      result.largest = m;
-      result.found = true;
-    }
+    const Region& r = sums_[static_cast<size_t>(i)];
+    if (r.moments.m00 < min_area) continue;
+    if (r.moments.m00 > result.largest.m00) result.largest = r.moments;
+    result.found = true;
+    keep_candidate(result, r);
   }
   return result;
+}
+
+cv::Mat Segmenter::mask_of(const Region& region) {
+  const cv::Rect box = (cv::Rect(region.x_min - 1, region.y_min - 1, region.x_max - region.x_min + 3,
+                                 region.y_max - region.y_min + 3)) &
+                       window_;
+  mask_origin_ = box.tl();
+  cv::Mat mask(box.height, box.width, CV_8UC1, mask_.data());
+  if (box.empty()) return mask;
+  for (int y = 0; y < box.height; ++y) {
+    const int32_t* row = labels_.data() + static_cast<size_t>(box.y - window_.y + y) * window_.width +
+                         (box.x - window_.x);
+    uint8_t* out = mask.ptr<uint8_t>(y);
+    for (int x = 0; x < box.width; ++x) {
+      out[x] = row[x] != 0 && parent_[static_cast<size_t>(row[x])] == region.label ? 255 : 0;
+    }
+  }
+  return mask;
 }
 
 }  // namespace sg::vision

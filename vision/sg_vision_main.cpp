@@ -53,9 +53,11 @@ struct Options {
 /// Runs the stereo step on each pair and publishes what it found.
 class StereoVision {
  public:
-  StereoVision(sg::Bus& bus, const sg::vision::BlobTracker::Params& params, cv::Size size,
+  StereoVision(sg::Bus& bus, const sg::vision::VisionSettings& settings, cv::Size size,
                std::optional<sg::vision::StereoCalibration> calibration, bool publish_images)
-      : bus_(bus), step_(params, size, std::move(calibration)), publish_images_(publish_images) {}
+      : bus_(bus),
+        step_(settings.tracker, size, std::move(calibration), settings.match),
+        publish_images_(publish_images) {}
 
   void process(const cv::Mat& left, const cv::Mat& right, int64_t frame_number, int64_t utime) {
     if (publish_images_) {
@@ -261,7 +263,6 @@ int main(int argc, char** argv) {
     const sg::Config config = sg::load_common(common);
     if (*learn) return learn_color(learn_image, learn_roi);
     const sg::vision::VisionSettings settings = sg::vision::read_vision_settings(config);
-    const auto& params = settings.tracker;
     if (o.calibration.empty()) o.calibration = settings.calibration;
     std::optional<sg::vision::StereoCalibration> calibration;
     if (!o.calibration.empty()) calibration = sg::vision::read_calibration(o.calibration);
@@ -273,7 +274,7 @@ int main(int argc, char** argv) {
     const cv::Size size = calibration
                               ? cv::Size(calibration->left.width(), calibration->left.height())
                               : cv::Size(o.width, o.height);
-    StereoVision vision(bus, params, size, calibration, o.publish_images);
+    StereoVision vision(bus, settings, size, calibration, o.publish_images);
     return o.source == "lcm" ? run_lcm(bus, vision, o) : run_frames(vision, o);
   });
 }

@@ -24,6 +24,7 @@
 #include "stereograsp/point3_t.hpp"
 #include "vision/blob_tracker.hpp"
 #include "vision/calibration_file.hpp"
+#include "vision/stereo_match.hpp"
 
 namespace sg::vision {
 
@@ -46,8 +47,11 @@ class StereoStep {
   /// A reprojection error above this (pixels) sets point3_t::FLAG_LARGE_RESIDUAL.
   static constexpr double kLargeResidualPx = 3.0;
 
+  /// With a calibration and the scored selection, the ball is the pair of candidates that
+  /// agrees with the cameras' geometry (stereo_match.hpp); a camera whose candidate has no
+  /// partner keeps it only while it is tracking the ball in its window.
   StereoStep(const BlobTracker::Params& params, cv::Size size,
-             std::optional<StereoCalibration> calibration);
+             std::optional<StereoCalibration> calibration, const StereoMatchParams& match = {});
 
   /// Tracks both images (BGR), optionally hinted by the pixels where each camera should see the
   /// ball, and returns the blobs and the position, all stamped `utime`.
@@ -60,15 +64,20 @@ class StereoStep {
 
  private:
   void reset_size(cv::Size size);
+  std::array<int, 2> choose(const std::array<Detection, 2>& d) const;
+  std::optional<double> expected_radius(size_t camera) const;
 
   std::array<BlobTracker, 2> trackers_;
   cv::Size size_;
   std::optional<StereoCalibration> calibration_;
+  StereoMatchParams match_;
   StereoCounts counts_;
+  std::optional<Eigen::Vector3d> last_position_;  ///< the last triangulated ball
+  uint64_t last_position_pair_ = 0;               ///< counts_.pairs when it was
 };
 
 /// OBJECT_POSITION from both cameras' observations: visible only when both found the ball
-/// (seen_by says which did); then the triangulated centre (eq. 26, refined), its per-axis sigma,
+/// (seen_by says which did); then the triangulated centre of the ball's images (Observation::centre) (eq. 26, refined), its per-axis sigma,
 /// the reprojection error and the geometry flags; otherwise NaN position and sigma.
 stereograsp::point3_t position_of(const std::array<Observation, 2>& o,
                                   const StereoCalibration& calibration, int64_t utime);

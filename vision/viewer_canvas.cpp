@@ -7,7 +7,7 @@ namespace sg::vision {
 namespace {
 
 const cv::Scalar kCross(0, 255, 0), kAxes(255, 128, 0), kBox(255, 255, 0), kPath(255, 0, 255),
-    kText(255, 255, 255);
+    kText(255, 255, 255), kFit(0, 200, 255);
 
 cv::Point px(double x, double y, int dx) { return {cvRound(x) + dx, cvRound(y)}; }
 
@@ -23,6 +23,16 @@ void draw_blob(cv::Mat& canvas, const stereograsp::blob_t& b, int dx) {
            px(b.minor_axis_ends[1][0], b.minor_axis_ends[1][1], dx), kAxes, 1);
   cv::rectangle(canvas, px(b.bounding_box[0], b.bounding_box[1], dx),
                 px(b.bounding_box[2], b.bounding_box[3], dx), kBox, 1);
+  // The ball's outline (and centre) as fitted when part of it is hidden; a value off the canvas,
+  // as a forged message may carry, is not drawn.
+  const double limit = 4.0 * canvas.cols;
+  if (std::isfinite(b.fit_support) && std::isfinite(b.centre[0]) && std::isfinite(b.centre[1]) &&
+      std::abs(b.centre[0]) < limit && std::abs(b.centre[1]) < limit && b.radius > 0 &&
+      b.radius < limit) {
+    const cv::Point centre = px(b.centre[0], b.centre[1], dx);
+    cv::circle(canvas, centre, cvRound(b.radius), kFit, 1, cv::LINE_AA);
+    cv::drawMarker(canvas, centre, kFit, cv::MARKER_TILTED_CROSS, 10, 1);
+  }
 }
 
 void draw_trajectory(cv::Mat& canvas, const stereograsp::trajectory_t& t, const CameraModel& cam,

@@ -39,6 +39,17 @@ VisionSettings read_vision_settings(const Config& config) {
   c.number("window_growth", w.growth, Range::closed(1, 100), "the window grows by this per miss");
   c.number("misses_before_full_frame", w.misses_before_full_frame, Range::closed(0, 1e6),
            "misses before the whole image is searched");
+  std::string selection = p.selection == Selection::kLargest ? "largest" : "scored";
+  c.choice("selection", selection, {"scored", "largest"},
+           "which region is the ball: scored (shape, size, colour, track, stereo) or the paper's "
+           "largest region");
+  p.selection = selection == "largest" ? Selection::kLargest : Selection::kScored;
+  c.number("ball_radius", s.match.ball_radius, Range::closed(0, 10),
+           "m: the ball's radius, for its size at its depth (0: unknown)");
+  c.number("epipolar_sigma", s.match.epipolar_sigma, Range::above_to(0, 1000),
+           "px: reprojection error of a true stereo pair");
+  c.number("max_cost", p.scoring.max_cost, Range::above_to(0, 1e6),
+           "a region scoring worse than this is not the ball");
   c.done();
   return s;
 }

@@ -4,12 +4,14 @@
 
 #include "common/config.hpp"
 #include "vision/blob_tracker.hpp"
+#include "vision/stereo_match.hpp"
 
 namespace sg::vision {
 
 /// What sg-vision is configured with: the `vision` section (docs/vision.md).
 struct VisionSettings {
   BlobTracker::Params tracker;
+  StereoMatchParams match;  ///< the ball's radius and the stereo pairing
   std::string calibration;  ///< a stereo calibration file; with it OBJECT_POSITION is published
 };
 
