@@ -1,5 +1,7 @@
 #include "vision/stereo_step.hpp"
 
+#include "vision/sphere_image.hpp"
+
 #include <spdlog/spdlog.h>
 
 #include <cmath>
@@ -89,9 +91,12 @@ point3_t position_of(const std::array<Observation, 2>& o, const StereoCalibratio
   for (int i = 0; i < 3; ++i) p.position[i] = p.position_sigma[i] = nan;
   p.reprojection_error = nan;
   if (!p.visible) return p;
-  // eq. 26, refined on the reprojection error, with its uncertainty
-  const auto t = triangulate({&calibration.left, &calibration.right},
-                             {{o[0].centre.x, o[0].centre.y}, {o[1].centre.x, o[1].centre.y}});
+  // eq. 26, refined on the reprojection error, with its uncertainty, from the pixels of the
+  // ball's centre (the ellipse's centre lies off it: sphere_image.hpp)
+  const auto t = triangulate(
+      {&calibration.left, &calibration.right},
+      {sphere_centre_pixel(calibration.left, {o[0].centre.x, o[0].centre.y}, o[0].radius),
+       sphere_centre_pixel(calibration.right, {o[1].centre.x, o[1].centre.y}, o[1].radius)});
   for (int i = 0; i < 3; ++i) p.position[i] = t.position[i], p.position_sigma[i] = t.sigma[i];
   p.reprojection_error = t.reprojection_error;
   if (t.behind_camera) p.flags |= point3_t::FLAG_BEHIND_CAMERA;
