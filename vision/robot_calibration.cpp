@@ -1,5 +1,9 @@
 #include "vision/robot_calibration.hpp"
 
+#include "vision/sphere_image.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <cmath>
 
@@ -17,6 +21,112 @@ double lerp(double a, double b, int i, int n) {
   return n == 1 ? (a + b) / 2 : a + (b - a) * i / (n - 1);
 }
 
+/// Stop k's orientation: `down` tilted by +-tilt about the tool's x axis (even k) or y axis (odd
+/// k), the sign alternating every two stops.
+Eigen::Vector3d tilted_rpy(const Eigen::Vector3d& down, double tilt, size_t k) {
+  if (tilt == 0) return down;
+  const double sign = (k / 2) % 2 == 0 ? 1.0 : -1.0;
+  const Eigen::Vector3d axis = k % 2 == 0 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  const Eigen::Matrix3d r = rotation(down) * Eigen::AngleAxisd(sign * tilt, axis).toRotationMatrix();
+  const Eigen::Vector3d ypr = r.eulerAngles(2, 1, 0);
+  return {ypr.z(), ypr.y(), ypr.x()};
+}
+
+/// One stop as the hand-eye solve sees it.
+struct Seen {
+  Eigen::Vector3d tool;
+  Eigen::Matrix3d rotation;
+  std::array<Eigen::Vector2d, 2> pixel;
+  std::array<double, 2> radius;
+};
+
+/// Unit directions of the offset that the stops observe (columns; see solve_hand_eye).
+Eigen::MatrixXd observable_directions(const std::vector<Seen>& seen) {
+  Eigen::Matrix3d mean = Eigen::Matrix3d::Zero();
+  for (const Seen& s : seen) mean += s.rotation / static_cast<double>(seen.size());
+  Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+  for (const Seen& s : seen) m += (s.rotation - mean).transpose() * (s.rotation - mean);
+  m /= static_cast<double>(seen.size());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m);
+  std::vector<int> keep;
+  for (int k = 0; k < 3; ++k) {
+    if (eig.eigenvalues()(k) >= 0.05 * 0.05) keep.push_back(k);
+  }
+  Eigen::MatrixXd b(3, static_cast<Eigen::Index>(keep.size()));
+  for (size_t k = 0; k < keep.size(); ++k)
+    b.col(static_cast<Eigen::Index>(k)) = eig.eigenvectors().col(keep[k]);
+  return b;
+}
+
+/// Both cameras' DLT with the ball at tool + R d.
+std::array<DltResult, 2> cameras_for(const std::vector<Seen>& seen, const Eigen::Vector3d& d,
+                                     int width, int height) {
+  std::array<std::vector<Correspondence>, 2> points;
+  for (const Seen& s : seen) {
+    for (size_t c = 0; c < 2; ++c) points[c].push_back({s.tool + s.rotation * d, s.pixel[c]});
+  }
+  return {calibrate_dlt(points[0], width, height), calibrate_dlt(points[1], width, height)};
+}
+
+/// Residuals (4 per stop: both cameras' u, v) and their Jacobian in the joint parameters
+/// theta = (P_left row-major, P_right row-major, y), the ball at tool + R (d0 + B y).
+void joint_residuals(const std::vector<Seen>& seen, const Eigen::VectorXd& theta,
+                     const Eigen::Vector3d& d0, const Eigen::MatrixXd& b, Eigen::VectorXd& r,
+                     Eigen::MatrixXd& j) {
+  const Eigen::Index k = b.cols();
+  r.setZero(static_cast<Eigen::Index>(4 * seen.size()));
+  j.setZero(r.size(), 24 + k);
+  const Eigen::Vector3d d = d0 + b * theta.tail(k);
+  for (size_t i = 0; i < seen.size(); ++i) {
+    const Eigen::Vector4d x = (seen[i].tool + seen[i].rotation * d).homogeneous();
+    for (Eigen::Index c = 0; c < 2; ++c) {
+      const Eigen::Matrix<double, 3, 4> p =
+          Eigen::Map<const Eigen::Matrix<double, 3, 4, Eigen::RowMajor>>(theta.data() + 12 * c);
+      const Eigen::Vector3d h = p * x;
+      if (!(std::abs(h.z()) > 1e-12)) continue;
+      const auto row = static_cast<Eigen::Index>(4 * i) + 2 * c;
+      const Eigen::Vector2d uv = h.head<2>() / h.z();
+      r.segment<2>(row) = uv - seen[i].pixel[static_cast<size_t>(c)];
+      for (int a = 0; a < 2; ++a) {
+        j.block<1, 4>(row + a, 12 * c + 4 * a) = x.transpose() / h.z();
+        j.block<1, 4>(row + a, 12 * c + 8) = -uv(a) * x.transpose() / h.z();
+        const Eigen::RowVector3d dx = (p.block<1, 3>(a, 0) - uv(a) * p.block<1, 3>(2, 0)) / h.z();
+        j.block(row + a, 24, 1, k) = dx * seen[i].rotation * b;
+      }
+    }
+  }
+}
+
+/// Levenberg-Marquardt on the joint reprojection error from the cameras `cams`; returns the
+/// offset and counts the rounds in `rounds`.
+Eigen::Vector3d joint_offset(const std::vector<Seen>& seen, const std::array<DltResult, 2>& cams,
+                             const Eigen::Vector3d& d0, const Eigen::MatrixXd& b, int& rounds) {
+  Eigen::VectorXd theta = Eigen::VectorXd::Zero(24 + b.cols());
+  for (int c = 0; c < 2; ++c) {
+    Eigen::Map<Eigen::Matrix<double, 3, 4, Eigen::RowMajor>>(theta.data() + 12 * c) =
+        cams[static_cast<size_t>(c)].P;
+  }
+  Eigen::VectorXd r, r_try;
+  Eigen::MatrixXd j, j_try;
+  joint_residuals(seen, theta, d0, b, r, j);
+  double lambda = 1e-3;
+  for (rounds = 0; rounds < 100 && lambda < 1e12; ++rounds) {
+    Eigen::MatrixXd a = j.transpose() * j;
+    a.diagonal() += lambda * a.diagonal().cwiseMax(1e-12);
+    const Eigen::VectorXd step = a.ldlt().solve(-j.transpose() * r);
+    if (!step.allFinite()) break;
+    const Eigen::VectorXd next = theta + step;
+    joint_residuals(seen, next, d0, b, r_try, j_try);
+    if (r_try.squaredNorm() < r.squaredNorm()) {
+      const bool settled = (b * step.tail(b.cols())).norm() < 1e-7;
+      theta = next, r = r_try, j = j_try, lambda = std::max(lambda / 10, 1e-12);
+      if (settled) break;
+    } else {
+      lambda *= 10;
+    }
+  }
+  return d0 + b * theta.tail(b.cols());
+}
 }  // namespace
 
 Eigen::Vector3d tool_down_rpy(const Eigen::Vector3d& position) {
@@ -45,7 +155,16 @@ RobotCalibrationParams load_robot_calibration_params(const Config& config) {
   c.numbers("tool_rpy", rpy.data(), 3, Range::closed(-7, 7), "tool roll pitch yaw at every stop (rad)");
   if (rpy_given) p.tool_rpy = rpy;
   c.numbers("ball_offset", p.ball_offset.data(), 3, Range::closed(-1, 1),
-            "the ball's centre from the tool centre point, tool frame (m)");
+            "the ball's centre from the tool centre point, tool frame (m): the first guess");
+  c.flag("estimate_ball_offset", p.estimate_ball_offset,
+         "estimate the ball's offset on the tool with the cameras (hand-eye)");
+  c.number("offset_gain", p.offset_gain, Range::closed(0, 1),
+           "the estimated offset is kept when it brings the RMS reprojection error to this "
+           "fraction of the configured offset's or below");
+  c.number("tilt", p.tilt, Range::closed(0, 0.8),
+           "rad of tool tilt, alternating at the stops (0: all tool-down)");
+  c.number("min_fit_support", p.min_fit_support, Range::closed(0, 1),
+           "least share of the ball's outline a blob must show to be averaged");
   c.number("speed", p.speed, Range::above_to(0, 1), "arm speed, fraction of the joint limits");
   c.number("frames_per_stop", p.frames_per_stop, Range::closed(1, 10000),
            "blobs averaged per camera at each stop");
@@ -73,7 +192,8 @@ RobotCalibration::RobotCalibration(const RobotCalibrationParams& p, int64_t firs
         stop.tool = {lerp(p.box_min.x(), p.box_max.x(), ii, p.nx),
                      lerp(p.box_min.y(), p.box_max.y(), j, p.ny),
                      lerp(p.box_min.z(), p.box_max.z(), k, p.nz)};
-        stop.rpy = p.tool_rpy ? *p.tool_rpy : tool_down_rpy(stop.tool);
+        stop.rpy = tilted_rpy(p.tool_rpy ? *p.tool_rpy : tool_down_rpy(stop.tool), p.tilt,
+                              stops_.size());
         stop.ball = stop.tool + rotation(stop.rpy) * p.ball_offset;
         stops_.push_back(stop);
       }
@@ -103,12 +223,14 @@ void RobotCalibration::on_arm_rejected(int64_t sequence, const std::string& reas
 }
 
 void RobotCalibration::on_blob(int camera, int64_t utime, bool found,
-                               const Eigen::Vector2d& centroid) {
+                               const Eigen::Vector2d& centre, double fit_support, double radius) {
   if (done() || phase_ != Phase::kSettling || camera < 0 || camera > 1) return;
   if (utime < arrived_utime_ + static_cast<int64_t>(params_.settle * 1e6)) return;
   CalibrationStop& stop = stops_[current_];
   const auto c = static_cast<size_t>(camera);
-  if (!found || !centroid.allFinite()) {
+  const bool hidden = found && fit_support < params_.min_fit_support;  // false for NaN
+  if (!found || !centre.allFinite() || hidden) {
+    stop.hidden += hidden ? 1 : 0;
     if (++stop.misses >= params_.max_misses_per_stop) {
       stop.skipped = true;
       finish_stop();
@@ -116,7 +238,8 @@ void RobotCalibration::on_blob(int camera, int64_t utime, bool found,
     return;
   }
   if (stop.frames[c] >= params_.frames_per_stop) return;
-  sums_[c] += centroid;
+  sums_[c] += centre;
+  radius_sums_[c] += std::isfinite(radius) && radius > 0 ? radius : 0;
   ++stop.frames[c];
   if (stop.frames[0] >= params_.frames_per_stop && stop.frames[1] >= params_.frames_per_stop)
     finish_stop();
@@ -126,8 +249,10 @@ void RobotCalibration::finish_stop() {
   CalibrationStop& stop = stops_[current_];
   for (size_t c = 0; c < 2; ++c) {
     if (stop.frames[c] > 0) stop.pixel[c] = sums_[c] / stop.frames[c];
+    if (stop.frames[c] > 0) stop.radius[c] = radius_sums_[c] / stop.frames[c];
   }
   sums_ = {Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
+  radius_sums_ = {0, 0};
   ++current_;
   phase_ = Phase::kSend;
 }
@@ -144,24 +269,46 @@ std::string RobotCalibration::progress() const {
          std::to_string(params_.frames_per_stop) + ")";
 }
 
-StereoCalibration RobotCalibration::solve() const {
-  std::array<std::vector<Correspondence>, 2> points;
+HandEyeSolution RobotCalibration::solve_hand_eye() const {
+  std::vector<Seen> seen;
   for (const CalibrationStop& s : stops_) {
     if (s.skipped || s.frames[0] == 0 || s.frames[1] == 0) continue;
-    for (size_t c = 0; c < 2; ++c) points[c].push_back({s.ball, s.pixel[c]});
+    seen.push_back({s.tool, rotation(s.rpy), s.pixel, s.radius});
   }
-  if (points[0].size() < 6) {
+  if (seen.size() < 6) {
     throw CalibrationInputError("the ball was seen by both cameras at only " +
-                                std::to_string(points[0].size()) + " stops; the DLT needs 6");
+                                std::to_string(seen.size()) + " stops; the DLT needs 6");
   }
-  StereoCalibration out;
-  const DltResult left = calibrate_dlt(points[0], params_.image_width, params_.image_height);
-  const DltResult right = calibrate_dlt(points[1], params_.image_width, params_.image_height);
-  out.left = left.camera;
-  out.right = right.camera;
-  out.rms_left = left.rms;
-  out.rms_right = right.rms;
-  out.source = "sg-calibrate robot (" + std::to_string(points[0].size()) + " stops)";
+  const int w = params_.image_width, h = params_.image_height;
+  HandEyeSolution out;
+  out.ball_offset = params_.ball_offset;
+  const Eigen::MatrixXd b = params_.estimate_ball_offset ? observable_directions(seen)
+                                                         : Eigen::MatrixXd(3, 0);
+  out.offset_dims = static_cast<int>(b.cols());
+  std::array<DltResult, 2> cams;
+  for (int pass = 0; pass < 2; ++pass) {
+    if (pass == 1) {  // the pixels of the ball's centre, with the first pass's cameras
+      for (Seen& s : seen) {
+        for (size_t c = 0; c < 2; ++c)
+          s.pixel[c] = sphere_centre_pixel(cams[c].camera, s.pixel[c], s.radius[c]);
+      }
+    }
+    out.ball_offset = params_.ball_offset;
+    cams = cameras_for(seen, out.ball_offset, w, h);
+    out.rms_configured = std::hypot(cams[0].rms, cams[1].rms) / std::sqrt(2.0);
+    out.rms_estimated = out.rms_configured;
+    if (out.offset_dims == 0) continue;
+    const Eigen::Vector3d d = joint_offset(seen, cams, out.ball_offset, b, out.iterations);
+    const std::array<DltResult, 2> with_d = cameras_for(seen, d, w, h);
+    out.rms_estimated = std::hypot(with_d[0].rms, with_d[1].rms) / std::sqrt(2.0);
+    out.offset_accepted = out.rms_estimated <= params_.offset_gain * out.rms_configured;
+    if (out.offset_accepted) out.ball_offset = d, cams = with_d;
+  }
+  out.cameras.left = cams[0].camera;
+  out.cameras.right = cams[1].camera;
+  out.cameras.rms_left = cams[0].rms;
+  out.cameras.rms_right = cams[1].rms;
+  out.cameras.source = "sg-calibrate robot (" + std::to_string(seen.size()) + " stops)";
   return out;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,7 +26,26 @@ struct RobotCalibrationParams {
   /// The tool's roll, pitch, yaw at every stop; unset: pointing down, the fingers across the line
   /// from the waist axis, (pi, 0, atan2(y, x) + pi), which keeps joint 6 near zero.
   std::optional<Eigen::Vector3d> tool_rpy;
-  Eigen::Vector3d ball_offset{0, 0, 0};  ///< ball centre from the tool centre point, tool frame
+  /// The ball's centre from the tool centre point, tool frame (m): the first guess of the
+  /// hand-eye estimate, and the value kept in directions the stops cannot observe.
+  Eigen::Vector3d ball_offset{0, 0, 0};
+  /// Estimate the ball's offset in the tool frame together with the cameras (solve_hand_eye);
+  /// false: the configured ball_offset is taken as exact.
+  bool estimate_ball_offset = true;
+  /// The estimated offset is kept only when it brings the RMS reprojection error to this
+  /// fraction of the configured offset's or below. The ball's centre in an image where the
+  /// gripper hides half its outline is off by a pixel or two, and that error turns with the
+  /// tool, as an offset does; an offset that explains little more than such errors is not one.
+  /// (A real 2 cm offset leaves the configured one several pixels of error.)
+  double offset_gain = 0.75;
+  /// rad: stops alternate a tilt of +tilt and -tilt about the tool's x and y axes (0: all
+  /// tool-down). With tool-down stops that differ only in yaw the offset along the tool's axis
+  /// moves every ball position alike and stays unobservable; a tilt makes it observable.
+  double tilt = 0.0;
+  /// A blob whose fitted circle has less of its outline than this (blob_t.fit_support) shows too
+  /// little of the ball (the gripper hides it): it is not averaged. NaN support (a whole disc, no
+  /// fit needed) always counts.
+  double min_fit_support = 0.45;
   double speed = 0.5;                    ///< fraction of the arm's maximum
   int frames_per_stop = 10;              ///< blobs averaged per camera at each stop
   double settle = 0.5;                   ///< s after arrival before blobs count
@@ -45,6 +65,18 @@ Eigen::Vector3d tool_down_rpy(const Eigen::Vector3d& position);
 /// than 12 points or 2 heights, speed outside (0, 1]).
 RobotCalibrationParams load_robot_calibration_params(const Config& config);
 
+/// What robot-guided calibration found: both cameras in the robot frame and where the ball sits
+/// on the tool.
+struct HandEyeSolution {
+  StereoCalibration cameras;
+  Eigen::Vector3d ball_offset{0, 0, 0};  ///< ball centre from the tool centre point, tool frame
+  int offset_dims = 0;  ///< directions of the offset the stops observed (0-3); others as given
+  int iterations = 0;   ///< Levenberg-Marquardt rounds of the joint solve
+  bool offset_accepted = false;  ///< the estimate was kept (offset_gain); else as configured
+  double rms_configured = 0;     ///< px, RMS reprojection error with the configured offset
+  double rms_estimated = 0;      ///< px, with the estimated one
+};
+
 /// A move the procedure wants the arm to make.
 struct ArmTarget {
   int64_t sequence = 0;
@@ -59,8 +91,10 @@ struct CalibrationStop {
   Eigen::Vector3d rpy;   ///< commanded tool orientation
   Eigen::Vector3d ball;  ///< the ball's centre (tool + offset), robot frame
   std::array<Eigen::Vector2d, 2> pixel{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
+  std::array<double, 2> radius{0, 0};  ///< mean radius of the ball's image, px
   std::array<int, 2> frames{0, 0};
   int misses = 0;
+  int hidden = 0;  ///< blobs left out because the gripper hid too much (min_fit_support)
   bool skipped = false;
   std::string rejected;  ///< why the arm refused the move (then skipped)
 };
@@ -72,9 +106,9 @@ struct CalibrationStop {
 ///     while (!cal.done()) {
 ///       if (auto t = cal.next_target()) publish_arm_command(*t);
 ///       ... on ARM_STATUS: cal.on_arm_status(utime, last_executed_sequence, idle);
-///       ... on BLOB_LEFT/RIGHT: cal.on_blob(camera, utime, found, centroid);
+///       ... on BLOB_LEFT/RIGHT: cal.on_blob(camera, utime, found, centre, fit_support);
 ///     }
-///     StereoCalibration c = cal.solve();
+///     HandEyeSolution s = cal.solve_hand_eye();   // cameras and the ball's offset on the tool
 class RobotCalibration {
  public:
   explicit RobotCalibration(const RobotCalibrationParams& params, int64_t first_sequence = 1);
@@ -85,8 +119,11 @@ class RobotCalibration {
   void on_arm_status(int64_t utime, int64_t last_executed_sequence, bool idle);
   /// The arm refused command `sequence` (out of reach, say): its stop is skipped with `reason`.
   void on_arm_rejected(int64_t sequence, const std::string& reason);
-  /// One camera's (0 left, 1 right) blob.
-  void on_blob(int camera, int64_t utime, bool found, const Eigen::Vector2d& centroid);
+  /// One camera's (0 left, 1 right) blob: the ball's centre (blob_t.centre: the fitted circle's
+  /// when the gripper hides part of it) and the share of its outline that supported the fit
+  /// (NaN: a whole disc, no fit), and its image's radius in px (0: unknown).
+  void on_blob(int camera, int64_t utime, bool found, const Eigen::Vector2d& centre,
+               double fit_support = std::nan(""), double radius = 0);
 
   bool done() const { return current_ >= stops_.size(); }
   /// "stop 4 of 18: collecting (left 3/10, right 2/10)" and the like.
@@ -96,9 +133,27 @@ class RobotCalibration {
   /// The parameters the grid was made from.
   const RobotCalibrationParams& params() const { return params_; }
 
-  /// DLT for both cameras in the robot frame from the stops seen by both; throws
-  /// CalibrationInputError when fewer than 6 remain. `rms` per camera in the result.
-  StereoCalibration solve() const;
+  /// The cameras and the ball's offset on the tool, hand-eye style. At stop i the tool centre
+  /// point is t_i and its orientation R_i, so the ball's centre is X_i = t_i + R_i d for the
+  /// unknown offset d (tool frame). Minimised over both cameras' P and d, the reprojection error
+  ///     sum_i,c || pi(P_c [X_i; 1]) - x_ic ||^2
+  /// starts from both cameras' DLT (eq. 5-6, refined) at the configured d, then Levenberg-
+  /// Marquardt runs on both P (row-major, 24 numbers) and d together (d pi / d X =
+  /// (A_0 - u A_2; A_1 - v A_2) / w for P = [A | b], w = A_2 X + b_2), until d moves less than
+  /// 0.1 µm (at most 100 rounds); the cameras are the DLT's again at the d found.
+  /// Only directions of d that the stops observe are estimated: those where R_i e differs from
+  /// stop to stop by at least 5% RMS (the eigenvectors of sum (R_i - R_mean)^T (R_i - R_mean));
+  /// along the others d moves every X_i alike, which the DLT absorbs, and the configured
+  /// ball_offset is kept. The estimate is kept only when it cuts the reprojection error to
+  /// offset_gain of the configured offset's. With estimate_ball_offset false, d is the
+  /// configured offset. Throws
+  /// CalibrationInputError when fewer than 6 stops were seen by both cameras.
+  /// The pixels are the image's centres, which lie off the projection of the ball's centre off
+  /// the optical axis (sphere_image.hpp); so the solve runs twice, the second time on the pixels
+  /// sphere_centre_pixel() gives with the first solve's cameras and each stop's radius.
+  HandEyeSolution solve_hand_eye() const;
+  /// solve_hand_eye().cameras.
+  StereoCalibration solve() const { return solve_hand_eye().cameras; }
 
  private:
   enum class Phase { kSend, kMoving, kSettling };
@@ -107,6 +162,7 @@ class RobotCalibration {
   RobotCalibrationParams params_;
   std::vector<CalibrationStop> stops_;
   std::array<Eigen::Vector2d, 2> sums_;
+  std::array<double, 2> radius_sums_{0, 0};
   size_t current_ = 0;
   Phase phase_ = Phase::kSend;
   int64_t sequence_;

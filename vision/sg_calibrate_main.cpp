@@ -15,6 +15,7 @@
 // A file is written only when the whole calibration succeeded (never a partial one over a good
 // one).
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -214,12 +215,40 @@ int warn_skipped(const std::vector<sg::vision::CalibrationStop>& stops) {
     if (!s.rejected.empty()) {
       spdlog::warn("stop ({:.3f}, {:.3f}, {:.3f}) skipped: the arm refused it: {}", s.tool.x(),
                    s.tool.y(), s.tool.z(), s.rejected);
+    } else if (s.skipped && s.hidden * 2 > s.misses) {
+      spdlog::warn("stop ({:.3f}, {:.3f}, {:.3f}) skipped: the gripper hid too much of the ball",
+                   s.tool.x(), s.tool.y(), s.tool.z());
     } else if (s.skipped) {
       spdlog::warn("stop ({:.3f}, {:.3f}, {:.3f}) skipped: the ball was not seen by both cameras",
                    s.tool.x(), s.tool.y(), s.tool.z());
     }
   }
   return skipped;
+}
+
+/// Solves the cameras and the ball's offset on the tool, prints what was found and writes them.
+void solve_and_write(const sg::vision::RobotCalibration& cal, const std::string& out) {
+  const int skipped = warn_skipped(cal.stops());
+  int hidden = 0;
+  for (const auto& s : cal.stops()) hidden += s.hidden;
+  sg::vision::HandEyeSolution h;
+  try {
+    h = cal.solve_hand_eye();
+  } catch (const CalibrationInputError& e) {
+    throw std::runtime_error(e.what());
+  }
+  const Eigen::Vector3d mm = h.ball_offset * 1e3;
+  h.cameras.source += fmt::format(", ball offset on the tool ({:.1f}, {:.1f}, {:.1f}) mm", mm.x(),
+                                  mm.y(), mm.z());
+  std::printf("%zu stops (%d skipped); RMS reprojection error left %.3f px, right %.3f px\n",
+              cal.stops().size(), skipped, h.cameras.rms_left, h.cameras.rms_right);
+  std::printf("ball offset on the tool (%.1f, %.1f, %.1f) mm: %s (%d of 3 directions observed; "
+              "RMS reprojection %.3f px as configured, %.3f px estimated); %d blobs left out with "
+              "the ball mostly hidden\n",
+              mm.x(), mm.y(), mm.z(), h.offset_accepted ? "estimated" : "as configured",
+              h.offset_dims, h.rms_configured, h.rms_estimated, hidden);
+  sg::vision::write_calibration(out, h.cameras);
+  std::printf("wrote %s (robot frame)\n", out.c_str());
 }
 
 int run_robot(const std::string& url, const sg::vision::RobotCalibrationParams& params,
@@ -234,7 +263,7 @@ int run_robot(const std::string& url, const sg::vision::RobotCalibrationParams& 
   bus.subscribe<stereograsp::arm_status_t>(
       "ARM_STATUS", [&](const auto& status, const auto&) { arm.on_status(status, cal); });
   bus.subscribe<stereograsp::blob_t>("BLOB_(LEFT|RIGHT)", [&](const auto& b, const auto&) {
-    cal.on_blob(b.camera, b.utime, b.found, {b.centroid[0], b.centroid[1]});
+    cal.on_blob(b.camera, b.utime, b.found, {b.centre[0], b.centre[1]}, b.fit_support, b.radius);
   });
   std::string last_progress;
   auto last_change = std::chrono::steady_clock::now();
@@ -266,17 +295,7 @@ int run_robot(const std::string& url, const sg::vision::RobotCalibrationParams& 
   commander.release();
   if (!cal.done())
     throw std::runtime_error("interrupted at " + cal.progress() + "; nothing written");
-  const int skipped = warn_skipped(cal.stops());
-  sg::vision::StereoCalibration c;
-  try {
-    c = cal.solve();
-  } catch (const CalibrationInputError& e) {
-    throw std::runtime_error(e.what());
-  }
-  std::printf("%zu stops (%d skipped); RMS reprojection error left %.3f px, right %.3f px\n",
-              cal.stops().size(), skipped, c.rms_left, c.rms_right);
-  sg::vision::write_calibration(out, c);
-  std::printf("wrote %s (robot frame)\n", out.c_str());
+  solve_and_write(cal, out);
   return 0;
 }
 

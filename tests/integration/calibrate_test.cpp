@@ -210,6 +210,8 @@ TEST(Calibrate, RobotGuidedOverLcm) {
       b.found = 1;
       const Eigen::Vector2d px = *rig[static_cast<size_t>(c)].project(ball);
       b.centroid[0] = px.x() + noise(rng), b.centroid[1] = px.y() + noise(rng);
+      b.centre[0] = b.centroid[0], b.centre[1] = b.centroid[1];  // a whole disc: no fit
+      b.fit_support = std::nan("");
       bus.publish(c == 0 ? "BLOB_LEFT" : "BLOB_RIGHT", b);
     }
   }

@@ -77,9 +77,10 @@ TEST(RobotCalibrationGrid, EveryDefaultStopIsReachable) {
   }
 }
 
-// The whole procedure over the bus: 18 stops, none skipped, sub-2-px reprojection error, and a
-// calibration that triangulates the true pixels of points through the grid's box within 15 mm
-// RMS (the gripper's fingers and palm hide part of the ball, which biases its centroid).
+// The whole procedure over the bus: 18 stops, at most 3 left out where the gripper hides most of
+// the ball, sub-2-px reprojection error, and a calibration that triangulates the true pixels of
+// points through the grid's box within 3 mm RMS (1.6 mm measured; 10.7 mm when the centroid of
+// the part the gripper leaves visible was taken for the ball's centre).
 TEST(RobotCalibrationProcesses, CalibratesTheSimulatedCamerasInTheRobotFrame) {
   ASSERT_TRUE(multicast_available(kPort));
   const std::string dir = make_temp_dir();
@@ -119,7 +120,12 @@ TEST(RobotCalibrationProcesses, CalibratesTheSimulatedCamerasInTheRobotFrame) {
   for (Child* c : {&vision_process, &cameras, &driver, &sim}) c->signal(SIGINT);
   for (Child* c : {&vision_process, &cameras, &driver, &sim}) c->wait(5s);
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
-  EXPECT_NE(r.out.find("18 stops (0 skipped)"), std::string::npos) << r.out;
+  int skipped = -1;
+  const size_t at = r.out.find("18 stops (");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  ASSERT_EQ(std::sscanf(r.out.c_str() + at, "18 stops (%d skipped)", &skipped), 1) << r.out;
+  EXPECT_LE(skipped, 3) << r.out;
+  EXPECT_NE(r.out.find("ball offset on the tool"), std::string::npos) << r.out;
 
   const auto truth = vision::read_calibration(dir + "/truth.yaml");
   const auto estimate = vision::read_calibration(dir + "/cams.yaml");
@@ -127,7 +133,7 @@ TEST(RobotCalibrationProcesses, CalibratesTheSimulatedCamerasInTheRobotFrame) {
   EXPECT_LT(estimate.rms_right, 2.0);
   const vision::RobotCalibrationParams p;
   const double rms = triangulation_rms(truth, estimate, p.box_min, p.box_max);
-  EXPECT_LT(rms, 0.015);
+  EXPECT_LT(rms, 0.003);
   std::printf(
       "robot-guided calibration: %.0f s, RMS reprojection %.3f/%.3f px, triangulation RMS "
       "%.1f mm through the grid's box\n",
