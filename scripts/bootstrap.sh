@@ -34,6 +34,7 @@ packages=(
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev  # config, flags, logging
   libeigen3-dev                                    # linear algebra
   libopencv-dev                                    # images, video files, calibration
+  opencv-doc                                       # real photographs and video (real-scene tests)
   libturbojpeg0-dev                                # a JPEG's size from its header, before decoding
   libgtest-dev libgmock-dev libbenchmark-dev       # tests and benchmarks
   nlohmann-json3-dev                               # sg-report's report.json (and its tests)
