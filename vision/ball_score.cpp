@@ -13,6 +13,7 @@ double shape_cost(const Candidate& c, const ScoringParams& p) {
   if (c.whole_disc) return 0.0;
   double cost = std::isfinite(c.fit_rms) ? square(c.fit_rms / p.fit_rms_scale) : 0.0;
   const double support = std::isfinite(c.support) ? c.support : 0.0;
+  if (support < p.min_support / 2) return p.max_cost + 1;  // no circle in its outline
   if (support < p.min_support) cost += square((p.min_support - support) / 0.1);
   if (support >= p.fit_below_support && c.blob.minor_axis > 0) {
     const double excess = std::log(c.blob.major_axis / c.blob.minor_axis) - std::log(p.max_axis_ratio);

@@ -7,7 +7,7 @@
 ///   shape:   0 for a region whose moments and extent already show a whole disc; else
 ///            (rms / fit_rms_scale)^2 of the circle fitted to its outline (a sphere images as a
 ///            near-circle), plus ((min_support - support) / 0.1)^2 when less of a circle than
-///            `min_support` supports it, plus the moments' axis ratio l / w (eq. 16-17) beyond
+///            `min_support` supports it (under half of min_support: not the ball), plus the moments' axis ratio l / w (eq. 16-17) beyond
 ///            `max_axis_ratio`, in ln units over `axis_ratio_scale`, when the whole disc is seen;
 ///   size:    (ln(radius / expected) / size_scale)^2, the expected radius from the ball's depth
 ///            (stereo) or from its last image;
@@ -44,6 +44,10 @@ struct ScoringParams {
   double clutter_cost = 16.0;      ///< added for a region on learned background
   double largest_weight = 0.5;     ///< per ln unit of area below the window's largest region
   double max_cost = 25.0;          ///< above: not the ball
+  /// Above: not the ball when there is no track or the last frame missed it. Continuity lets a
+  /// tracked ball be taken through a frame that looks little like one (a finger across it);
+  /// a new track starts only from a region that looks like a ball on its own.
+  double acquire_max_cost = 4.0;
   /// The fitted circle's centre replaces the centroid when less than this of its outline is seen
   /// (a whole disc's centroid is the more precise, 0.13 px against the fit's ~0.3 px).
   double fit_below_support = 0.9;

@@ -71,7 +71,7 @@ ScoreContext BlobTracker::context(const std::optional<cv::Point2d>& predicted,
   return x;
 }
 
-Candidate BlobTracker::describe(const Region& region) {
+Candidate BlobTracker::describe(const Region& region, std::optional<double> hint) {
   Candidate c;
   c.blob = blob_from_moments(region.moments);
   c.centre = c.blob.centroid;
@@ -97,7 +97,18 @@ Candidate BlobTracker::describe(const Region& region) {
   edge_.clear();
   const cv::Mat mask = segmenter_.mask_of(region);
   append_edge_points(mask, segmenter_.mask_origin(), segmenter_.window(), edge_);
-  const BallFit fit = fitter_.fit(edge_, params_.fit);
+  BallFit fit = fitter_.fit(edge_, params_.fit);
+  if (hint && (!fit.ok || fit.support < 0.5)) {
+    // The ball touching another region of its colour (a red jacket, an orange): region pixels
+    // lie outside the ball's circle, which the first fit forbids. Near the expected radius, a
+    // circle that most of an outline supports is the ball's.
+    BallFitParams merged = params_.fit;
+    merged.outside_penalty = 0.05, merged.hint_weight = 1.0, merged.hint_scale = 0.15;
+    const BallFit m = fitter_.fit(edge_, merged, hint);
+    if (m.ok && m.support >= 0.5 && m.support > (fit.ok ? fit.support : 0) + 0.15 &&
+        std::abs(std::log(m.radius / *hint)) < 0.25)
+      fit = m;
+  }
   if (!fit.ok) {
     c.support = 0;
     return c;
@@ -135,10 +146,13 @@ Detection BlobTracker::detect(const cv::Mat& bgr, const std::optional<cv::Point2
   o.num_regions = s.num_regions;
   ScoreContext x = context(predicted, expected_radius);
   if (s.num_candidates > 0) x.largest_area = static_cast<double>(s.regions[0].moments.m00);
-  double best = params_.scoring.max_cost;
+  // A track that is new or has missed must start again from a candidate that looks like a ball.
+  double best = has_track_ && misses_ == 0 ? params_.scoring.max_cost
+                                           : std::min(params_.scoring.max_cost,
+                                                      params_.scoring.acquire_max_cost);
   for (int k = 0; k < s.num_candidates; ++k) {
     Candidate& c = d.candidates[static_cast<size_t>(k)];
-    c = describe(s.regions[static_cast<size_t>(k)]);
+    c = describe(s.regions[static_cast<size_t>(k)], x.expected_radius);
     ++d.count;
     if (params_.selection == Selection::kLargest) break;  // the largest is the target
     c.cost = candidate_cost(c, x, params_.scoring);

@@ -114,7 +114,7 @@ class BlobTracker {
   const ColorModel& colour() const { return colour_; }
 
  private:
-  Candidate describe(const Region& region);
+  Candidate describe(const Region& region, std::optional<double> hint);
   ScoreContext context(const std::optional<cv::Point2d>& predicted,
                        const std::optional<double>& expected_radius) const;
   void learn_clutter(const Detection& d, int index);

@@ -50,6 +50,8 @@ VisionSettings read_vision_settings(const Config& config) {
            "px: reprojection error of a true stereo pair");
   c.number("max_cost", p.scoring.max_cost, Range::above_to(0, 1e6),
            "a region scoring worse than this is not the ball");
+  c.number("acquire_max_cost", p.scoring.acquire_max_cost, Range::above_to(0, 1e6),
+           "... and worse than this starts no track (none yet, or the last frame missed)");
   c.done();
   return s;
 }
