@@ -81,7 +81,7 @@ class RealScene {
   std::mt19937_64 rng_;
 };
 
-/// The benchmark's and tests' set: home.jpg (a room) with the cloth, fruits.jpg (an orange and
+/// The benchmark's and tests' set: home.jpg (houses against the sky) with the cloth, fruits.jpg (an orange and
 /// red cabbage) and vtest.avi (people walking) with the cloth, `frames` each, the book in all.
 /// (Not in it: a ball in front of a red surface of its own colour, baboon.jpg's nose, which one
 /// camera's colour segmentation cannot part from it; and a second red ball that stays put, which

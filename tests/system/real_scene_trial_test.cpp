@@ -26,10 +26,10 @@ bool have_data() {
          std::filesystem::exists(sim::opencv_data_dir() + "/vtest.avi");
 }
 
-// The room with a cloth 25 times the ball's area, two cycles: the ball within 2 px of its true
+// home.jpg (houses, sky) with a cloth 25 times the ball's area, two cycles: the ball within 2 px of its true
 // centre in every fully visible frame, never on another object, no detection while it is hidden
 // (444 hidden frames).
-TEST(RealSceneTrial, RoomWithARedClothScored) {
+TEST(RealSceneTrial, HousesWithARedClothScored) {
   if (!have_data()) GTEST_SKIP() << "no opencv-doc data in " << sim::opencv_data_dir();
   const RealSceneFigures& f = scored(0);
   ASSERT_GT(f.visible, 600);
@@ -40,7 +40,7 @@ TEST(RealSceneTrial, RoomWithARedClothScored) {
 }
 
 // The half-hidden ball (40-60% of its disc visible, behind the panel or between the fingers) in
-// the room and among the walking people: its centre within 1.5 px at p95, where the centroid
+// home.jpg and among the walking people: its centre within 1.5 px at p95, where the centroid
 // of eq. 11 is off by a third of the radius.
 TEST(RealSceneTrial, HalfHiddenBallsCentre) {
   if (!have_data()) GTEST_SKIP() << "no opencv-doc data in " << sim::opencv_data_dir();
@@ -64,7 +64,7 @@ TEST(RealSceneTrial, WalkingPeopleScored) {
   EXPECT_LE(f.hidden_false, f.hidden / 100);
 }
 
-// The paper's rule on the same room: the cloth is the largest red region, so it is taken for
+// The paper's rule on the same scene: the cloth is the largest red region, so it is taken for
 // the ball in nearly every frame.
 TEST(RealSceneTrial, LargestRegionRuleTakesTheCloth) {
   if (!have_data()) GTEST_SKIP() << "no opencv-doc data in " << sim::opencv_data_dir();
