@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/support/allocation_counter.hpp"
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -19,20 +21,6 @@
 #include <numeric>
 #include <opencv2/imgproc.hpp>
 #include <tuple>
-
-namespace {
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-// Every allocation in this test program passes through here (BallFitter.FitAllocatesNothing).
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-void* operator new(std::size_t size) {
-  ++g_allocations;
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace sg::vision {
 namespace {
@@ -359,14 +347,14 @@ TEST(BallFitter, FitAllocatesNothingAndItsTime) {
   for (const auto* edge : {&half, &whole}) {
     const int runs = 4000;
     double sum = 0;
-    const long before = g_allocations.load();
+    const long before = sg::test::allocations();
     const auto start = std::chrono::steady_clock::now();
     for (int i = 0; i < runs; ++i) sum += fitter.fit(*edge, BallFitParams{}, 32.0).centre.x;
     const double us =
         std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start)
             .count() /
         runs;
-    EXPECT_EQ(g_allocations.load() - before, 0);
+    EXPECT_EQ(sg::test::allocations() - before, 0);
     EXPECT_TRUE(std::isfinite(sum));
     std::printf("%s disc, %zu edge points: %.2f us per fit\n", edge == &half ? "half" : "whole",
                 edge->size(), us);

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/support/allocation_counter.hpp"
+
 #include <atomic>
 #include <cstdlib>
 #include <new>
@@ -10,22 +12,6 @@
 
 #include "vision/blob_tracker.hpp"
 #include "vision/vision_config.hpp"
-
-namespace {
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-// Every allocation in this test program passes through here.
-// gcc 12 at -O1 (the sanitizer build) inlines gtest's `new TestClass` and this delete, and takes
-// the malloc behind the replaced operator new for a mismatched allocation.
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-void* operator new(std::size_t size) {
-  ++g_allocations;
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace sg::vision {
 namespace {
@@ -40,13 +26,13 @@ TEST(Tracking, NoAllocationPerFrame) {
   }
   BlobTracker tracker({}, {640, 480});
   for (int k = 0; k < 3; ++k) tracker.track(frames[static_cast<size_t>(k)]);  // warm up
-  const long before = g_allocations.load();
+  const long before = sg::test::allocations();
   int found = 0;
   for (size_t k = 3; k < frames.size(); ++k) found += tracker.track(frames[k]).found;
-  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_EQ(sg::test::allocations() - before, 0);
   EXPECT_EQ(found, 17);
   cv::Mat copy = frames[0].clone();  // the counter does count: OpenCV allocates here
-  EXPECT_GT(g_allocations.load() - before, 0);
+  EXPECT_GT(sg::test::allocations() - before, 0);
 }
 
 // config/stereograsp.yaml's vision section is the tracker's defaults; a bad value names its key.
