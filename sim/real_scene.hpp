@@ -38,12 +38,12 @@ struct RealSceneParams {
   std::string background = "home.jpg";  ///< in opencv_data_dir(): a photograph or a video
   int frames = 1440;
   uint64_t seed = 1;
-  bool cloth = true;        ///< a red-brown cloth, about 25 times the ball's area
-  bool red_book = true;     ///< a red book 60x36 px with a yellow band, fixed (static clutter)
-  bool lighting = true;     ///< exposure 0.65-1.25 and colour-temperature drift
-  double noise_sigma = 3.0; ///< grey levels of Gaussian sensor noise
-  int jpeg_quality = 80;    ///< per-frame JPEG (MJPG); 0: none
-  bool occlusion = true;    ///< panel, fingers and out-of-view segments (else always visible)
+  bool cloth = true;         ///< a red-brown cloth, about 25 times the ball's area
+  bool red_book = true;      ///< a red book 60x36 px with a yellow band, fixed (static clutter)
+  bool lighting = true;      ///< exposure 0.65-1.25 and colour-temperature drift
+  double noise_sigma = 3.0;  ///< grey levels of Gaussian sensor noise
+  int jpeg_quality = 80;     ///< per-frame JPEG (MJPG); 0: none
+  bool occlusion = true;     ///< panel, fingers and out-of-view segments (else always visible)
 };
 
 /// What frame k shows.
@@ -72,20 +72,21 @@ class RealScene {
   void draw_clutter(cv::Mat& image) const;
   double occlude(int phase, const RealSceneTruth& t, cv::Mat& image, cv::Mat& coverage) const;
   void degrade(int k, cv::Mat& image);
+  void make_noise_bank();
 
   RealSceneParams params_;
-  cv::Mat photo_;          // a still background, 640x480
+  cv::Mat photo_;           // a still background, 640x480
   cv::VideoCapture video_;  // or a video's frames
   int video_frames_ = 0;
-  cv::Mat texture_;        // the cloth's weave, CV_32F
-  std::mt19937_64 rng_;
+  cv::Mat texture_;             // the cloth's weave, CV_32F
+  std::vector<cv::Mat> noise_;  // Gaussian fields, CV_16SC3, a margin larger than the frame
 };
 
-/// The benchmark's and tests' set: home.jpg (houses against the sky) with the cloth, fruits.jpg (an orange and
-/// red cabbage) and vtest.avi (people walking) with the cloth, `frames` each, the book in all.
-/// (Not in it: a ball in front of a red surface of its own colour, baboon.jpg's nose, which one
-/// camera's colour segmentation cannot part from it; and a second red ball that stays put, which
-/// one camera cannot tell from the ball until one of them moves.)
+/// The benchmark's and tests' set: home.jpg (houses against the sky) with the cloth, fruits.jpg (an
+/// orange and red cabbage) and vtest.avi (people walking) with the cloth, `frames` each, the book
+/// in all. (Not in it: a ball in front of a red surface of its own colour, baboon.jpg's nose, which
+/// one camera's colour segmentation cannot part from it; and a second red ball that stays put,
+/// which one camera cannot tell from the ball until one of them moves.)
 std::vector<RealSceneParams> standard_real_scenes(int frames);
 
 }  // namespace sg::sim

@@ -44,10 +44,12 @@ void RealSceneFigures::add(const RealSceneFigures& o) {
   seconds.insert(seconds.end(), o.seconds.begin(), o.seconds.end());
 }
 
-RealSceneFigures run_real_scene(const sim::RealSceneParams& scene, vision::Selection selection) {
+RealSceneFigures run_real_scene(const sim::RealSceneParams& scene, vision::Selection selection,
+                                bool adapt_colour) {
   sim::RealScene generator(scene);
   vision::BlobTracker::Params params;
   params.selection = selection;
+  params.adaptation.enabled = adapt_colour;
   vision::BlobTracker tracker(params, {640, 480});
   RealSceneFigures f;
   cv::Mat bgr;

@@ -21,15 +21,15 @@ namespace sg::system {
 
 struct RealSceneFigures {
   int frames = 0;
-  int visible = 0;          ///< fully visible frames
+  int visible = 0;  ///< fully visible frames
   int visible_within_2px = 0;
   int visible_missed = 0;
   int visible_elsewhere = 0;  ///< ... where the detection lay on another object
   int half_hidden = 0;
-  std::vector<double> half_centre_error;    ///< px, Observation::centre, per half-hidden frame found
+  std::vector<double> half_centre_error;  ///< px, Observation::centre, per half-hidden frame found
   std::vector<double> half_centroid_error;  ///< px, the region's centroid (eq. 11), same frames
   int hidden = 0;
-  int hidden_false = 0;  ///< hidden frames with a detection
+  int hidden_false = 0;         ///< hidden frames with a detection
   std::vector<double> seconds;  ///< the tracker's time per frame
 
   double within_2px_share() const { return visible ? visible_within_2px / double(visible) : 0; }
@@ -37,9 +37,10 @@ struct RealSceneFigures {
   void add(const RealSceneFigures& other);
 };
 
-/// Runs the tracker with `selection` (other parameters the defaults sg-vision starts from) over
-/// every frame of the scene.
-RealSceneFigures run_real_scene(const sim::RealSceneParams& scene, vision::Selection selection);
+/// Runs the tracker with `selection` and colour adaptation on or off (other parameters the
+/// defaults sg-vision starts from) over every frame of the scene.
+RealSceneFigures run_real_scene(const sim::RealSceneParams& scene, vision::Selection selection,
+                                bool adapt_colour = true);
 
 /// The q-quantile (0..1) of `v` by nearest rank; NaN when empty.
 double quantile(std::vector<double> v, double q);

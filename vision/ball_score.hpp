@@ -7,8 +7,9 @@
 ///   shape:   0 for a region whose moments and extent already show a whole disc; else
 ///            (rms / fit_rms_scale)^2 of the circle fitted to its outline (a sphere images as a
 ///            near-circle), plus ((min_support - support) / 0.1)^2 when less of a circle than
-///            `min_support` supports it (under half of min_support: not the ball), plus the moments' axis ratio l / w (eq. 16-17) beyond
-///            `max_axis_ratio`, in ln units over `axis_ratio_scale`, when the whole disc is seen;
+///            `min_support` supports it (under half of min_support: not the ball), plus the
+///            moments' axis ratio l / w (eq. 16-17) beyond `max_axis_ratio`, in ln units over
+///            `axis_ratio_scale`, when the whole disc is seen;
 ///   size:    (ln(radius / expected) / size_scale)^2, the expected radius from the ball's depth
 ///            (stereo) or from its last image;
 ///   motion:  (|centre - expected| / sigma)^2, sigma = motion_scale x the ball's last diameter
@@ -25,8 +26,8 @@
 ///     if (cost <= ScoringParams{}.max_cost) ...   // it may be the ball
 
 #include <cmath>
-#include <optional>
 #include <opencv2/core.hpp>
+#include <optional>
 
 #include "vision/moments.hpp"
 
@@ -48,6 +49,12 @@ struct ScoringParams {
   /// tracked ball be taken through a frame that looks little like one (a finger across it);
   /// a new track starts only from a region that looks like a ball on its own.
   double acquire_max_cost = 4.0;
+  /// ... and only from a region whose outline shows at least this share of the circle (a whole
+  /// disc passes): a sliver of red is no ball on its own, whatever its circle's cost.
+  double acquire_min_support = 0.5;
+  /// The ball's size is learned only from candidates whose circle this much of the outline
+  /// supports (or a whole disc): a nearly hidden ball's fitted radius is too uncertain to keep.
+  double size_min_support = 0.5;
   /// The fitted circle's centre replaces the centroid when less than this of its outline is seen
   /// (a whole disc's centroid is the more precise, 0.13 px against the fit's ~0.3 px).
   double fit_below_support = 0.9;
@@ -57,9 +64,9 @@ struct ScoringParams {
 
 /// One region of the ball's colour with what scoring knows of it.
 struct Candidate {
-  Blob blob;                 ///< eq. 11-22 of the region
-  cv::Point2d centre;        ///< the ball's centre: fitted circle or centroid
-  double radius = 0;         ///< px: fitted, or sqrt(area / pi)
+  Blob blob;                      ///< eq. 11-22 of the region
+  cv::Point2d centre;             ///< the ball's centre: fitted circle or centroid
+  double radius = 0;              ///< px: fitted, or sqrt(area / pi)
   double support = std::nan("");  ///< of the fitted circle's circumference (NaN: not fitted)
   double fit_rms = std::nan("");  ///< px
   bool fitted = false;            ///< centre is the fitted circle's

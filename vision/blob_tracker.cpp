@@ -38,7 +38,11 @@ bool looks_like_a_whole_disc(const Blob& b, const Region& region) {
 }  // namespace
 
 BlobTracker::BlobTracker(const Params& params, cv::Size image_size)
-    : params_(params), size_(image_size), detector_(params.color), segmenter_(image_size) {
+    : params_(params),
+      size_(image_size),
+      detector_(params.color),
+      segmenter_(image_size),
+      adaptation_(params.color, params.adaptation) {
   if (image_size.width <= 0 || image_size.height <= 0)
     throw std::invalid_argument("BlobTracker: image size must be positive");
   edge_.reserve(8192);
@@ -59,8 +63,7 @@ ScoreContext BlobTracker::context(const std::optional<cv::Point2d>& predicted,
   ScoreContext x;
   if (has_track_) {
     x.expected_centre = predicted.value_or(last_centre_);
-    x.motion_sigma =
-        params_.scoring.motion_scale * std::max(last_diameter_, 10.0) * (1 + misses_);
+    x.motion_sigma = params_.scoring.motion_scale * std::max(last_diameter_, 10.0) * (1 + misses_);
   }
   if (expected_radius) {
     x.expected_radius = expected_radius;
@@ -71,7 +74,7 @@ ScoreContext BlobTracker::context(const std::optional<cv::Point2d>& predicted,
   return x;
 }
 
-Candidate BlobTracker::describe(const Region& region, std::optional<double> hint) {
+Candidate BlobTracker::describe(const Region& region) {
   Candidate c;
   c.blob = blob_from_moments(region.moments);
   c.centre = c.blob.centroid;
@@ -97,18 +100,7 @@ Candidate BlobTracker::describe(const Region& region, std::optional<double> hint
   edge_.clear();
   const cv::Mat mask = segmenter_.mask_of(region);
   append_edge_points(mask, segmenter_.mask_origin(), segmenter_.window(), edge_);
-  BallFit fit = fitter_.fit(edge_, params_.fit);
-  if (hint && (!fit.ok || fit.support < 0.5)) {
-    // The ball touching another region of its colour (a red jacket, an orange): region pixels
-    // lie outside the ball's circle, which the first fit forbids. Near the expected radius, a
-    // circle that most of an outline supports is the ball's.
-    BallFitParams merged = params_.fit;
-    merged.outside_penalty = 0.05, merged.hint_weight = 1.0, merged.hint_scale = 0.15;
-    const BallFit m = fitter_.fit(edge_, merged, hint);
-    if (m.ok && m.support >= 0.5 && m.support > (fit.ok ? fit.support : 0) + 0.15 &&
-        std::abs(std::log(m.radius / *hint)) < 0.25)
-      fit = m;
-  }
+  const BallFit fit = fitter_.fit(edge_, params_.fit);
   if (!fit.ok) {
     c.support = 0;
     return c;
@@ -128,6 +120,7 @@ Detection BlobTracker::detect(const cv::Mat& bgr, const std::optional<cv::Point2
                                 std::to_string(size_.height) + " BGR image");
   ++frame_;
   Detection d;
+  d.image = bgr;
   Observation& o = d.frame;
   o.misses = misses_;
   o.tracking = has_track_ && misses_ < params_.window.misses_before_full_frame;
@@ -147,15 +140,16 @@ Detection BlobTracker::detect(const cv::Mat& bgr, const std::optional<cv::Point2
   ScoreContext x = context(predicted, expected_radius);
   if (s.num_candidates > 0) x.largest_area = static_cast<double>(s.regions[0].moments.m00);
   // A track that is new or has missed must start again from a candidate that looks like a ball.
-  double best = has_track_ && misses_ == 0 ? params_.scoring.max_cost
-                                           : std::min(params_.scoring.max_cost,
-                                                      params_.scoring.acquire_max_cost);
+  const bool acquiring = !has_track_ || misses_ > 0;
+  double best = acquiring ? std::min(params_.scoring.max_cost, params_.scoring.acquire_max_cost)
+                          : params_.scoring.max_cost;
   for (int k = 0; k < s.num_candidates; ++k) {
     Candidate& c = d.candidates[static_cast<size_t>(k)];
-    c = describe(s.regions[static_cast<size_t>(k)], x.expected_radius);
+    c = describe(s.regions[static_cast<size_t>(k)]);
     ++d.count;
     if (params_.selection == Selection::kLargest) break;  // the largest is the target
     c.cost = candidate_cost(c, x, params_.scoring);
+    if (acquiring && !c.whole_disc && !(c.support >= params_.scoring.acquire_min_support)) continue;
     if (c.cost <= best) best = c.cost, d.best = k;
   }
   if (params_.selection == Selection::kLargest && d.count > 0) d.best = 0;
@@ -186,10 +180,20 @@ void BlobTracker::learn_clutter(const Detection& d, int index) {
   }
 }
 
+// A confident detection of the whole ball teaches its colour: the chromaticity for the score,
+// and the pixels of its image for the detector's ranges.
+void BlobTracker::learn_colour(const Detection& d, const Candidate& ball, double confidence) {
+  if (confidence < 0.5 || !(ball.whole_disc || ball.support >= 0.8)) return;
+  colour_.add(ball.mean_r, ball.mean_g);
+  if (!ball.fitted && !d.image.empty() && adaptation_.learn(d.image, ball.centre, ball.radius))
+    detector_ = ColorDetector(adaptation_.thresholds());
+}
+
 Observation BlobTracker::accept(const Detection& d, int index) {
   Observation o = d.frame;
   if (index < 0 || index >= d.count) {
-    if (has_track_) ++misses_;
+    if (has_track_ && ++misses_ == params_.forget_size_after_misses && adaptation_.forget())
+      detector_ = ColorDetector(adaptation_.thresholds());
     return o;
   }
   const Candidate& c = d.candidates[static_cast<size_t>(index)];
@@ -201,11 +205,14 @@ Observation BlobTracker::accept(const Detection& d, int index) {
   o.confidence = params_.selection == Selection::kLargest ? 1.0 : std::exp(-c.cost / 4);
   if (params_.selection == Selection::kScored) {
     learn_clutter(d, index);
-    if (o.confidence >= 0.5 && c.support >= 0.8) colour_.add(c.mean_r, c.mean_g);
+    learn_colour(d, c, o.confidence);
   }
+  // The size of a nearly hidden ball's circle is too uncertain to keep (unless there is none).
+  const bool sized = params_.selection == Selection::kLargest || c.whole_disc ||
+                     c.support >= params_.scoring.size_min_support || !has_track_;
   has_track_ = true;
   last_centre_ = c.centre;
-  last_diameter_ = 2 * c.radius;
+  if (sized) last_diameter_ = 2 * c.radius;
   last_area_ = c.blob.area;
   misses_ = 0;
   return o;

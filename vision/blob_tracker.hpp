@@ -1,14 +1,14 @@
 #pragma once
 
-#include <opencv2/core.hpp>
-#include <optional>
-
 #include <array>
 #include <cmath>
+#include <opencv2/core.hpp>
+#include <optional>
 #include <vector>
 
 #include "vision/ball_fit.hpp"
 #include "vision/ball_score.hpp"
+#include "vision/color_adaptation.hpp"
 #include "vision/color_detector.hpp"
 #include "vision/color_model.hpp"
 #include "vision/moments.hpp"
@@ -42,11 +42,11 @@ struct Observation {
   cv::Point2d centre;     ///< the ball's centre: fitted circle when partly hidden, else centroid
   double radius = 0;      ///< px, of the ball's image
   double fit_support = std::nan("");  ///< of the fitted circle's circumference (NaN: no fit)
-  double confidence = 0;  ///< 0..1, exp(-cost / 4) of the chosen candidate
-  int candidates = 0;     ///< regions of at least the minimum area that were scored
-  cv::Rect window;        ///< the window processed (the whole image when not tracking)
-  int num_regions = 0;    ///< regions of the object's colour in the window
-  int misses = 0;         ///< consecutive misses before this frame
+  double confidence = 0;              ///< 0..1, exp(-cost / 4) of the chosen candidate
+  int candidates = 0;                 ///< regions of at least the minimum area that were scored
+  cv::Rect window;                    ///< the window processed (the whole image when not tracking)
+  int num_regions = 0;                ///< regions of the object's colour in the window
+  int misses = 0;                     ///< consecutive misses before this frame
 };
 
 /// How the tracker picks the ball among the regions of its colour.
@@ -58,6 +58,7 @@ enum class Selection {
 /// One frame's candidates, before one is accepted as the ball.
 struct Detection {
   Observation frame;  ///< window, mode, regions, misses; found false
+  cv::Mat image;      ///< the frame detected in (shared, not copied): accept() learns its colour
   std::array<Candidate, Segmentation::kMaxRegions> candidates;
   int count = 0;
   int best = -1;  ///< the candidate the camera alone would take (-1: none)
@@ -91,6 +92,9 @@ class BlobTracker {
     /// while the ball is tracked elsewhere is learned as background (0: never).
     int clutter_frames = 30;
     double clutter_distance = 2.0;
+    /// The colour ranges narrowed to the ball's, within `color` (color_adaptation.hpp); they are
+    /// forgotten with the ball's size (forget_size_after_misses).
+    ColorAdaptationParams adaptation;
   };
 
   BlobTracker(const Params& params, cv::Size image_size);
@@ -112,12 +116,15 @@ class BlobTracker {
   bool has_track() const { return has_track_; }
   /// The learned colour (ColorModel), for a report.
   const ColorModel& colour() const { return colour_; }
+  /// The colour ranges detected with now (the configured ones, or narrowed to the ball's).
+  const ColorThresholds& color_ranges() const { return detector_.thresholds(); }
 
  private:
-  Candidate describe(const Region& region, std::optional<double> hint);
+  Candidate describe(const Region& region);
   ScoreContext context(const std::optional<cv::Point2d>& predicted,
                        const std::optional<double>& expected_radius) const;
   void learn_clutter(const Detection& d, int index);
+  void learn_colour(const Detection& d, const Candidate& ball, double confidence);
 
   struct Clutter {
     cv::Point2d centre;
@@ -133,6 +140,7 @@ class BlobTracker {
   BallFitter fitter_;
   std::vector<cv::Point2d> edge_;
   ColorModel colour_;
+  ColorAdaptation adaptation_;
   std::array<Clutter, 16> clutter_{};
   int64_t frame_ = 0;
   bool has_track_ = false;

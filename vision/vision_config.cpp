@@ -52,6 +52,15 @@ VisionSettings read_vision_settings(const Config& config) {
            "a region scoring worse than this is not the ball");
   c.number("acquire_max_cost", p.scoring.acquire_max_cost, Range::above_to(0, 1e6),
            "... and worse than this starts no track (none yet, or the last frame missed)");
+  c.number("acquire_min_support", p.scoring.acquire_min_support, Range::closed(0, 1),
+           "... nor a region with less of a circle in its outline (a whole disc: 1)");
+  ColorAdaptationParams& a = p.adaptation;
+  c.flag("adapt_color", a.enabled,
+         "narrow the colour ranges to the ball's as it is seen, within the ranges above");
+  c.number("adapt_margin", a.margin, Range::closed(0, 1),
+           "added on each side of the ball's learned ranges");
+  c.number("adapt_min_width", a.min_width, Range::closed(0, 1),
+           "a learned range is never narrower than this");
   c.done();
   return s;
 }

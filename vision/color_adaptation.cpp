@@ -1,0 +1,102 @@
+#include "vision/color_adaptation.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace sg::vision {
+namespace {
+
+constexpr size_t kMaxPixels = 8192;
+
+/// The configured band [lo, hi] cut to [learned_lo - margin, learned_hi + margin], at least
+/// `width` wide where the configured band allows.
+void narrow(double conf_lo, double conf_hi, double learned_lo, double learned_hi, double margin,
+            double width, double& lo, double& hi) {
+  lo = std::max(conf_lo, learned_lo - margin);
+  hi = std::min(conf_hi, learned_hi + margin);
+  if (hi < lo) lo = hi = std::clamp(0.5 * (learned_lo + learned_hi), conf_lo, conf_hi);
+  const double missing = width - (hi - lo);
+  if (missing > 0) {
+    lo -= missing / 2, hi += missing / 2;
+    if (lo < conf_lo) hi = std::min(conf_hi, hi + conf_lo - lo), lo = conf_lo;
+    if (hi > conf_hi) lo = std::max(conf_lo, lo - (hi - conf_hi)), hi = conf_hi;
+  }
+}
+
+double quantile_of(std::vector<float>& v, double q) {
+  const auto k = static_cast<size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
+}  // namespace
+
+ColorAdaptation::ColorAdaptation(const ColorThresholds& configured,
+                                 const ColorAdaptationParams& params)
+    : configured_(configured), current_(configured), p_(params) {
+  for (auto& band : pixels_) band.reserve(kMaxPixels);
+}
+
+bool ColorAdaptation::sample(const cv::Mat& bgr, const cv::Point2d& centre, double radius) {
+  for (auto& band : pixels_) band.clear();
+  if (bgr.type() != CV_8UC3 || !std::isfinite(centre.x) || !std::isfinite(centre.y) ||
+      !std::isfinite(radius) || radius <= 0 || radius > bgr.cols || centre.x < -radius ||
+      centre.y < -radius || centre.x > bgr.cols + radius || centre.y > bgr.rows + radius)
+    return false;
+  const double reach = p_.inner * radius, reach2 = reach * reach;
+  const int step = radius > 16 ? 2 : 1;
+  const int y0 = std::max(0, static_cast<int>(std::ceil(centre.y - reach)));
+  const int y1 = std::min(bgr.rows - 1, static_cast<int>(std::floor(centre.y + reach)));
+  const int x0 = std::max(0, static_cast<int>(std::ceil(centre.x - reach)));
+  const int x1 = std::min(bgr.cols - 1, static_cast<int>(std::floor(centre.x + reach)));
+  for (int y = y0; y <= y1; y += step) {
+    const auto* row = bgr.ptr<uint8_t>(y);
+    for (int x = x0; x <= x1 && pixels_[0].size() < kMaxPixels; x += step) {
+      const double dx = x - centre.x, dy = y - centre.y;
+      if (dx * dx + dy * dy > reach2) continue;
+      const uint8_t* px = row + 3 * x;
+      const int sum = px[0] + px[1] + px[2];
+      if (sum < configured_.min_intensity) continue;
+      pixels_[0].push_back(static_cast<float>(px[2]) / static_cast<float>(sum));
+      pixels_[1].push_back(static_cast<float>(px[1]) / static_cast<float>(sum));
+      pixels_[2].push_back(static_cast<float>(px[0]) / static_cast<float>(sum));
+    }
+  }
+  return static_cast<int>(pixels_[0].size()) >= p_.min_pixels;
+}
+
+bool ColorAdaptation::learn(const cv::Mat& bgr, const cv::Point2d& centre, double radius) {
+  if (!p_.enabled || !sample(bgr, centre, radius)) return false;
+  const double a = samples_ == 0 ? 1.0 : std::max(p_.rate, 1.0 / (samples_ + 1));
+  for (size_t b = 0; b < 3; ++b) {
+    low_[b] += a * (quantile_of(pixels_[b], p_.quantile) - low_[b]);
+    high_[b] += a * (quantile_of(pixels_[b], 1 - p_.quantile) - high_[b]);
+  }
+  ++samples_;
+  if (samples_ < p_.min_samples) return false;
+  const ColorThresholds before = current_;
+  update_current();
+  return before.r_min != current_.r_min || before.r_max != current_.r_max ||
+         before.g_min != current_.g_min || before.g_max != current_.g_max ||
+         before.b_min != current_.b_min || before.b_max != current_.b_max;
+}
+
+void ColorAdaptation::update_current() {
+  const ColorThresholds& c = configured_;
+  narrow(c.r_min, c.r_max, low_[0], high_[0], p_.margin, p_.min_width, current_.r_min,
+         current_.r_max);
+  narrow(c.g_min, c.g_max, low_[1], high_[1], p_.margin, p_.min_width, current_.g_min,
+         current_.g_max);
+  narrow(c.b_min, c.b_max, low_[2], high_[2], p_.margin, p_.min_width, current_.b_min,
+         current_.b_max);
+}
+
+bool ColorAdaptation::forget() {
+  const bool narrowed = samples_ >= p_.min_samples;
+  samples_ = 0;
+  low_ = {}, high_ = {};
+  current_ = configured_;
+  return narrowed;
+}
+
+}  // namespace sg::vision
