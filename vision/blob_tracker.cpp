@@ -192,7 +192,8 @@ void BlobTracker::learn_colour(const Detection& d, const Candidate& ball, double
 Observation BlobTracker::accept(const Detection& d, int index) {
   Observation o = d.frame;
   if (index < 0 || index >= d.count) {
-    if (has_track_ && ++misses_ == params_.forget_size_after_misses && adaptation_.forget())
+    // >=: forget_size_after_misses may be 0; forget() is a no-op once the ranges are configured.
+    if (has_track_ && ++misses_ >= params_.forget_size_after_misses && adaptation_.forget())
       detector_ = ColorDetector(adaptation_.thresholds());
     return o;
   }
