@@ -96,6 +96,7 @@ void fill(blob_t& m, Pattern& p) {
   p.fill(m.centre);
   m.radius = p.real();
   m.fit_support = p.real();
+  m.fit_arc = p.integer();
   m.confidence = p.real();
   m.candidates = p.below(100);
 }

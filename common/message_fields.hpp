@@ -38,8 +38,8 @@ void visit_fields(M& m, V& v) {
   SG_FIELD(centroid); SG_FIELD(area); SG_FIELD(major_axis); SG_FIELD(minor_axis);
   SG_FIELD(orientation); SG_FIELD(major_axis_ends); SG_FIELD(minor_axis_ends);
   SG_FIELD(bounding_box); SG_FIELD(search_window); SG_FIELD(num_regions); SG_FIELD(misses);
-  SG_FIELD(centre); SG_FIELD(radius); SG_FIELD(fit_support); SG_FIELD(confidence);
-  SG_FIELD(candidates);
+  SG_FIELD(centre); SG_FIELD(radius); SG_FIELD(fit_support); SG_FIELD(fit_arc);
+  SG_FIELD(confidence); SG_FIELD(candidates);
 }
 template <class M, class V>
   requires std::same_as<std::remove_const_t<M>, stereograsp::point3_t>

@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <stdexcept>
 
@@ -40,6 +41,10 @@ double turn_fraction(double y, double x) {
 }
 
 }  // namespace
+
+int arc_sector(double dx, double dy) {
+  return std::clamp(static_cast<int>(turn_fraction(dy, dx) * kArcSectors), 0, kArcSectors - 1);
+}
 
 void append_edge_points(const cv::Mat& mask, cv::Point origin, const cv::Rect& valid,
                         std::vector<cv::Point2d>& out) {
@@ -226,6 +231,26 @@ bool BallFitter::refine(Circle& c, size_t n, const BallFitParams& p) {
   return true;
 }
 
+uint64_t BallFitter::arc_of(const Circle& c, size_t n, double tolerance) {
+  sector_points_.fill(0);
+  for (size_t i = 0; i < n; ++i) {
+    const double dx = xs_[i] - c.x, dy = ys_[i] - c.y;
+    if (std::abs(std::sqrt(dx * dx + dy * dy) - c.r) > tolerance) continue;
+    uint16_t& k = sector_points_[static_cast<size_t>(arc_sector(dx, dy))];
+    k = static_cast<uint16_t>(std::min(k + 1, 65535));
+  }
+  // A whole outline has at least 1 edge point per px of arc (4-neighbour midpoints: |cos| + |sin|
+  // per px); half of that marks a sector seen, and a lone empty sector between two seen ones is
+  // a gap of the pixel grid (a small circle's sectors hold one point or none), not of the arc.
+  const double half = 0.5 * (2 * M_PI * c.r / kArcSectors);
+  uint64_t arc = 0;
+  for (int k = 0; k < kArcSectors; ++k) {
+    if (sector_points_[static_cast<size_t>(k)] >= std::max(1.0, half)) arc |= uint64_t{1} << k;
+  }
+  arc |= std::rotl(arc, 1) & std::rotr(arc, 1);
+  return arc;
+}
+
 BallFit BallFitter::describe(const Circle& c, size_t n, const BallFitParams& p) {
   BallFit f;
   f.points = static_cast<int>(n);
@@ -247,6 +272,7 @@ BallFit BallFitter::describe(const Circle& c, size_t n, const BallFitParams& p) 
   int covered = 0;
   for (int b = 0; b < bins; ++b) covered += bins_[static_cast<size_t>(b)];
   f.support = static_cast<double>(covered) / bins;
+  f.arc = arc_of(c, n, p.inlier_tolerance);
   f.rms = f.inliers > 0 ? std::sqrt(sum2 / f.inliers) : 0.0;
   const double out_share = static_cast<double>(f.outside) / static_cast<double>(n);
   const double q = f.rms / p.confidence_rms_scale;

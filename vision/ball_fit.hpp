@@ -83,7 +83,20 @@ struct BallFit {
   int points = 0;   ///< edge points used: finite, |x|,|y| <= 1e9, subsampled to max_points
   int outside = 0;  ///< edge points clearly outside the circle (d > r + outside_tolerance)
   double confidence = 0;  ///< 0..1, from support, rms and the share of points outside the circle
+  /// Which parts of the circle the fit rests on: bit k is set when the directions from the centre
+  /// atan2(y - cy, x - cx) in [-pi + k pi/32, -pi + (k + 1) pi/32) hold at least half the inlier
+  /// edge points a whole outline would put there at the least (arc_sector()), or lie between two
+  /// sectors that do. sphere_image.hpp uses it to
+  /// model the same fit on the ball's exact image (an ellipse off the optical axis).
+  uint64_t arc = 0;
 };
+
+/// Number of sectors of BallFit::arc.
+inline constexpr int kArcSectors = 64;
+/// All sectors: the whole outline (a whole disc's centroid rests on all of it).
+inline constexpr uint64_t kWholeArc = ~uint64_t{0};
+/// The sector of BallFit::arc holding direction (dx, dy) from the centre.
+int arc_sector(double dx, double dy);
 
 /// Fits the ball's image, a circle, to the edge points of its visible region. Occluder edges
 /// (straight runs, concave bites) lie INSIDE the true circle and no region point lies outside it,
@@ -110,7 +123,9 @@ struct BallFit {
 ///    removes Kåsa's bias toward small circles on short arcs; inliers are selected again with
 ///    the refined circle, `refinements` times.
 /// 5. Support: the circumference is cut in bins of about support_bin px; support is the share of
-///    bins holding an inlier. rms and the outside share come from the final circle.
+///    bins holding an inlier. rms and the outside share come from the final circle; arc marks
+///    the 64 sectors that hold at least half of the edge points a whole outline has there at the
+///    least (1 per px of arc: 4-neighbour midpoints), and lone gaps between them.
 ///
 /// fit() allocates nothing: its buffers are sized once in the constructor. It never throws on
 /// its input and ends in a bounded number of steps (O(iterations x points)); about 10 µs for
@@ -142,6 +157,7 @@ class BallFitter {
   bool kasa(Circle& c, size_t m) const;
   bool gauss_newton(Circle& c, size_t m, int steps) const;
   BallFit describe(const Circle& c, size_t n, const BallFitParams& p);
+  uint64_t arc_of(const Circle& c, size_t n, double tolerance);
 
   size_t max_points_;
   cv::Point2d offset_;                              // mean of the points used
@@ -150,6 +166,7 @@ class BallFitter {
   std::vector<std::pair<double, uint32_t>> order_;  // (pseudo-angle, index), sorted
   std::vector<uint32_t> inliers_;                   // indices of the current inliers
   std::array<uint8_t, kMaxBins> bins_{};
+  std::array<uint16_t, kArcSectors> sector_points_{};
 };
 
 }  // namespace sg::vision

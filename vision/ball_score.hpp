@@ -29,6 +29,7 @@
 #include <opencv2/core.hpp>
 #include <optional>
 
+#include "vision/ball_fit.hpp"
 #include "vision/moments.hpp"
 
 namespace sg::vision {
@@ -70,6 +71,8 @@ struct Candidate {
   double support = std::nan("");  ///< of the fitted circle's circumference (NaN: not fitted)
   double fit_rms = std::nan("");  ///< px
   bool fitted = false;            ///< centre is the fitted circle's
+  /// The sectors of the outline the centre rests on (BallFit::arc); kWholeArc for a centroid.
+  uint64_t arc = kWholeArc;
   /// The moments and the extent already show a whole disc (axis ratio, fill of its box, box
   /// aspect): no circle is fitted, centre is the centroid, support and fit_rms are NaN.
   bool whole_disc = false;

@@ -106,7 +106,7 @@ Candidate BlobTracker::describe(const Region& region) {
     return c;
   }
   c.fitted = fit.support < params_.scoring.fit_below_support;
-  if (c.fitted) c.centre = fit.centre;
+  if (c.fitted) c.centre = fit.centre, c.arc = fit.arc;
   c.radius = fit.radius;
   c.support = fit.support;
   c.fit_rms = fit.rms;
@@ -203,6 +203,7 @@ Observation BlobTracker::accept(const Detection& d, int index) {
   o.centre = c.centre;
   o.radius = c.radius;
   o.fit_support = c.support;
+  o.arc = c.arc;
   o.confidence = params_.selection == Selection::kLargest ? 1.0 : std::exp(-c.cost / 4);
   if (params_.selection == Selection::kScored) {
     learn_clutter(d, index);

@@ -42,11 +42,12 @@ struct Observation {
   cv::Point2d centre;     ///< the ball's centre: fitted circle when partly hidden, else centroid
   double radius = 0;      ///< px, of the ball's image
   double fit_support = std::nan("");  ///< of the fitted circle's circumference (NaN: no fit)
-  double confidence = 0;              ///< 0..1, exp(-cost / 4) of the chosen candidate
-  int candidates = 0;                 ///< regions of at least the minimum area that were scored
-  cv::Rect window;                    ///< the window processed (the whole image when not tracking)
-  int num_regions = 0;                ///< regions of the object's colour in the window
-  int misses = 0;                     ///< consecutive misses before this frame
+  uint64_t arc = 0;  ///< the outline's sectors the centre rests on (BallFit::arc); 0: not found
+  double confidence = 0;  ///< 0..1, exp(-cost / 4) of the chosen candidate
+  int candidates = 0;     ///< regions of at least the minimum area that were scored
+  cv::Rect window;        ///< the window processed (the whole image when not tracking)
+  int num_regions = 0;    ///< regions of the object's colour in the window
+  int misses = 0;         ///< consecutive misses before this frame
 };
 
 /// How the tracker picks the ball among the regions of its colour.

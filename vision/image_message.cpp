@@ -1,9 +1,8 @@
 #include "vision/image_message.hpp"
 
-#include <cmath>
-
 #include <turbojpeg.h>
 
+#include <cmath>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -123,9 +122,11 @@ stereograsp::blob_t to_blob_t(const Observation& o, int8_t camera, int64_t frame
   b.search_window[2] = o.window.width, b.search_window[3] = o.window.height;
   b.num_regions = o.num_regions;
   b.misses = o.misses;
-  b.centre[0] = o.found ? o.centre.x : std::nan(""), b.centre[1] = o.found ? o.centre.y : std::nan("");
+  b.centre[0] = o.found ? o.centre.x : std::nan(""),
+  b.centre[1] = o.found ? o.centre.y : std::nan("");
   b.radius = o.found ? o.radius : std::nan("");
   b.fit_support = o.found ? o.fit_support : std::nan("");
+  b.fit_arc = o.found ? static_cast<int64_t>(o.arc) : 0;
   b.confidence = o.confidence;
   b.candidates = o.candidates;
   return b;

@@ -1,11 +1,12 @@
 #include "vision/robot_calibration.hpp"
 
-#include "vision/sphere_image.hpp"
-
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
+
+#include "vision/sphere_image.hpp"
 
 namespace sg::vision {
 namespace {
@@ -27,18 +28,63 @@ Eigen::Vector3d tilted_rpy(const Eigen::Vector3d& down, double tilt, size_t k) {
   if (tilt == 0) return down;
   const double sign = (k / 2) % 2 == 0 ? 1.0 : -1.0;
   const Eigen::Vector3d axis = k % 2 == 0 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
-  const Eigen::Matrix3d r = rotation(down) * Eigen::AngleAxisd(sign * tilt, axis).toRotationMatrix();
+  const Eigen::Matrix3d r =
+      rotation(down) * Eigen::AngleAxisd(sign * tilt, axis).toRotationMatrix();
   const Eigen::Vector3d ypr = r.eulerAngles(2, 1, 0);
   return {ypr.z(), ypr.y(), ypr.x()};
 }
 
 /// One stop as the hand-eye solve sees it.
 struct Seen {
+  size_t stop;  ///< index in RobotCalibration::stops()
   Eigen::Vector3d tool;
   Eigen::Matrix3d rotation;
-  std::array<Eigen::Vector2d, 2> pixel;
+  std::array<Eigen::Vector2d, 2> pixel;  ///< the ball's centre as the images show it
   std::array<double, 2> radius;
+  const CalibrationStop* measured;  ///< the blobs as seen (pixel is corrected in place)
 };
+
+/// The mean over a stop's blobs in one camera of (centre - the centre the tracker's fit finds on
+/// the same sectors of the ball's exact image at x); nullopt when the model fails for one.
+std::optional<Eigen::Vector2d> mean_fit_error(
+    const std::vector<std::pair<Eigen::Vector2d, uint64_t>>& blobs, const CameraModel& camera,
+    const Eigen::Vector3d& x, double ball_radius) {
+  if (blobs.empty() || !(ball_radius > 0)) return std::nullopt;
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  std::optional<Eigen::Vector2d> fitted;
+  for (size_t i = 0; i < blobs.size(); ++i) {
+    if (i == 0 || blobs[i].second != blobs[i - 1].second)  // the same sectors: the same model
+      fitted = sphere_outline_centre(camera, x, ball_radius, blobs[i].second);
+    if (!fitted) return std::nullopt;
+    sum += blobs[i].first - *fitted;
+  }
+  return sum / static_cast<double>(blobs.size());
+}
+
+/// The pixels of the ball's centre at each stop from what the images show, with the cameras of
+/// the last pass and the ball at tool + R d: project(X) + the mean of each blob's centre less the
+/// fit the tracker makes on the ball's exact image (sphere_outline_centre), or without a ball
+/// radius the ellipse's
+/// centre correction from the image's radius (sphere_centre_pixel). Returns the most a pixel
+/// moved (px).
+double correct_pixels(std::vector<Seen>& seen, const std::array<DltResult, 2>& cams,
+                      const Eigen::Vector3d& d, double ball_radius) {
+  double moved = 0;
+  for (Seen& s : seen) {
+    const Eigen::Vector3d x = s.tool + s.rotation * d;
+    for (size_t c = 0; c < 2; ++c) {
+      const CameraModel& camera = cams[c].camera;
+      const auto centre = camera.project(x);
+      const auto error = mean_fit_error(s.measured->blobs[c], camera, x, ball_radius);
+      const Eigen::Vector2d pixel =
+          centre && error ? Eigen::Vector2d(*centre + *error)
+                          : sphere_centre_pixel(camera, s.measured->pixel[c], s.radius[c]);
+      moved = std::max(moved, (pixel - s.pixel[c]).norm());
+      s.pixel[c] = pixel;
+    }
+  }
+  return moved;
+}
 
 /// Unit directions of the offset that the stops observe (columns; see solve_hand_eye).
 Eigen::MatrixXd observable_directions(const std::vector<Seen>& seen) {
@@ -152,7 +198,8 @@ RobotCalibrationParams load_robot_calibration_params(const Config& config) {
   Eigen::Vector3d rpy(M_PI, 0, 0);
   const bool rpy_given =
       c.known("tool_rpy", "pi 0 atan2(y,x)+pi", "tool roll pitch yaw at every stop (rad)", 3);
-  c.numbers("tool_rpy", rpy.data(), 3, Range::closed(-7, 7), "tool roll pitch yaw at every stop (rad)");
+  c.numbers("tool_rpy", rpy.data(), 3, Range::closed(-7, 7),
+            "tool roll pitch yaw at every stop (rad)");
   if (rpy_given) p.tool_rpy = rpy;
   c.numbers("ball_offset", p.ball_offset.data(), 3, Range::closed(-1, 1),
             "the ball's centre from the tool centre point, tool frame (m): the first guess");
@@ -192,8 +239,8 @@ RobotCalibration::RobotCalibration(const RobotCalibrationParams& p, int64_t firs
         stop.tool = {lerp(p.box_min.x(), p.box_max.x(), ii, p.nx),
                      lerp(p.box_min.y(), p.box_max.y(), j, p.ny),
                      lerp(p.box_min.z(), p.box_max.z(), k, p.nz)};
-        stop.rpy = tilted_rpy(p.tool_rpy ? *p.tool_rpy : tool_down_rpy(stop.tool), p.tilt,
-                              stops_.size());
+        stop.rpy =
+            tilted_rpy(p.tool_rpy ? *p.tool_rpy : tool_down_rpy(stop.tool), p.tilt, stops_.size());
         stop.ball = stop.tool + rotation(stop.rpy) * p.ball_offset;
         stops_.push_back(stop);
       }
@@ -222,8 +269,8 @@ void RobotCalibration::on_arm_rejected(int64_t sequence, const std::string& reas
   finish_stop();
 }
 
-void RobotCalibration::on_blob(int camera, int64_t utime, bool found,
-                               const Eigen::Vector2d& centre, double fit_support, double radius) {
+void RobotCalibration::on_blob(int camera, int64_t utime, bool found, const Eigen::Vector2d& centre,
+                               double fit_support, double radius, uint64_t arc) {
   if (done() || phase_ != Phase::kSettling || camera < 0 || camera > 1) return;
   if (utime < arrived_utime_ + static_cast<int64_t>(params_.settle * 1e6)) return;
   CalibrationStop& stop = stops_[current_];
@@ -240,6 +287,7 @@ void RobotCalibration::on_blob(int camera, int64_t utime, bool found,
   if (stop.frames[c] >= params_.frames_per_stop) return;
   sums_[c] += centre;
   radius_sums_[c] += std::isfinite(radius) && radius > 0 ? radius : 0;
+  stop.blobs[c].emplace_back(centre, arc);
   ++stop.frames[c];
   if (stop.frames[0] >= params_.frames_per_stop && stop.frames[1] >= params_.frames_per_stop)
     finish_stop();
@@ -271,9 +319,10 @@ std::string RobotCalibration::progress() const {
 
 HandEyeSolution RobotCalibration::solve_hand_eye() const {
   std::vector<Seen> seen;
-  for (const CalibrationStop& s : stops_) {
+  for (size_t i = 0; i < stops_.size(); ++i) {
+    const CalibrationStop& s = stops_[i];
     if (s.skipped || s.frames[0] == 0 || s.frames[1] == 0) continue;
-    seen.push_back({s.tool, rotation(s.rpy), s.pixel, s.radius});
+    seen.push_back({i, s.tool, rotation(s.rpy), s.pixel, s.radius, &s});
   }
   if (seen.size() < 6) {
     throw CalibrationInputError("the ball was seen by both cameras at only " +
@@ -282,17 +331,13 @@ HandEyeSolution RobotCalibration::solve_hand_eye() const {
   const int w = params_.image_width, h = params_.image_height;
   HandEyeSolution out;
   out.ball_offset = params_.ball_offset;
-  const Eigen::MatrixXd b = params_.estimate_ball_offset ? observable_directions(seen)
-                                                         : Eigen::MatrixXd(3, 0);
+  const Eigen::MatrixXd b =
+      params_.estimate_ball_offset ? observable_directions(seen) : Eigen::MatrixXd(3, 0);
   out.offset_dims = static_cast<int>(b.cols());
   std::array<DltResult, 2> cams;
-  for (int pass = 0; pass < 2; ++pass) {
-    if (pass == 1) {  // the pixels of the ball's centre, with the first pass's cameras
-      for (Seen& s : seen) {
-        for (size_t c = 0; c < 2; ++c)
-          s.pixel[c] = sphere_centre_pixel(cams[c].camera, s.pixel[c], s.radius[c]);
-      }
-    }
+  for (double moved = INFINITY; out.passes < kMaxPasses && moved > kPixelsSettled; ++out.passes) {
+    // The pixels of the ball's centre, with the last pass's cameras.
+    if (out.passes > 0) moved = correct_pixels(seen, cams, out.ball_offset, params_.ball_radius);
     out.ball_offset = params_.ball_offset;
     cams = cameras_for(seen, out.ball_offset, w, h);
     out.rms_configured = std::hypot(cams[0].rms, cams[1].rms) / std::sqrt(2.0);
@@ -309,6 +354,14 @@ HandEyeSolution RobotCalibration::solve_hand_eye() const {
   out.cameras.rms_left = cams[0].rms;
   out.cameras.rms_right = cams[1].rms;
   out.cameras.source = "sg-calibrate robot (" + std::to_string(seen.size()) + " stops)";
+  out.residual.assign(stops_.size(), {NAN, NAN});
+  for (const Seen& s : seen) {
+    const Eigen::Vector3d x = s.tool + s.rotation * out.ball_offset;
+    for (size_t c = 0; c < 2; ++c) {
+      const auto px = cams[c].camera.project(x);
+      out.residual[s.stop][c] = px ? (*px - s.pixel[c]).norm() : NAN;
+    }
+  }
   return out;
 }
 

@@ -4,9 +4,11 @@
 #include <cmath>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/config.hpp"
+#include "vision/ball_fit.hpp"
 #include "vision/calibration_file.hpp"
 #include "vision/dlt.hpp"
 
@@ -46,11 +48,15 @@ struct RobotCalibrationParams {
   /// little of the ball (the gripper hides it): it is not averaged. NaN support (a whole disc, no
   /// fit needed) always counts.
   double min_fit_support = 0.45;
-  double speed = 0.5;                    ///< fraction of the arm's maximum
-  int frames_per_stop = 10;              ///< blobs averaged per camera at each stop
-  double settle = 0.5;                   ///< s after arrival before blobs count
-  int max_misses_per_stop = 60;          ///< frames without the ball before a stop is skipped
-  double timeout = 30;                   ///< s without progress before sg-calibrate gives up
+  /// m: the ball's radius, for the model of its image at each stop (sphere_outline_centre);
+  /// sg-calibrate takes vision.ball_radius. 0: unknown, the image's radius is used instead
+  /// (sphere_centre_pixel, which does not model a part of the outline).
+  double ball_radius = 0.035;
+  double speed = 0.5;            ///< fraction of the arm's maximum
+  int frames_per_stop = 10;      ///< blobs averaged per camera at each stop
+  double settle = 0.5;           ///< s after arrival before blobs count
+  int max_misses_per_stop = 60;  ///< frames without the ball before a stop is skipped
+  double timeout = 30;           ///< s without progress before sg-calibrate gives up
   int image_width = 640, image_height = 480;
 };
 
@@ -75,6 +81,10 @@ struct HandEyeSolution {
   bool offset_accepted = false;  ///< the estimate was kept (offset_gain); else as configured
   double rms_configured = 0;     ///< px, RMS reprojection error with the configured offset
   double rms_estimated = 0;      ///< px, with the estimated one
+  int passes = 0;  ///< solves, each on the pixels the last one's cameras corrected (see solve)
+  /// Per stop of RobotCalibration::stops() (NaN where skipped or unseen): the distance (px) in
+  /// each camera between the ball's centre projected by the result and its corrected pixel.
+  std::vector<std::array<double, 2>> residual;
 };
 
 /// A move the procedure wants the arm to make.
@@ -92,6 +102,10 @@ struct CalibrationStop {
   Eigen::Vector3d ball;  ///< the ball's centre (tool + offset), robot frame
   std::array<Eigen::Vector2d, 2> pixel{Eigen::Vector2d::Zero(), Eigen::Vector2d::Zero()};
   std::array<double, 2> radius{0, 0};  ///< mean radius of the ball's image, px
+  /// Each averaged blob's centre and the outline sectors it rests on (BallFit::arc): where a
+  /// finger splits the ball's image the fit may take one part in one frame and the other in the
+  /// next, centres px apart, so each is modelled on its own.
+  std::array<std::vector<std::pair<Eigen::Vector2d, uint64_t>>, 2> blobs;
   std::array<int, 2> frames{0, 0};
   int misses = 0;
   int hidden = 0;  ///< blobs left out because the gripper hid too much (min_fit_support)
@@ -121,9 +135,10 @@ class RobotCalibration {
   void on_arm_rejected(int64_t sequence, const std::string& reason);
   /// One camera's (0 left, 1 right) blob: the ball's centre (blob_t.centre: the fitted circle's
   /// when the gripper hides part of it) and the share of its outline that supported the fit
-  /// (NaN: a whole disc, no fit), and its image's radius in px (0: unknown).
+  /// (NaN: a whole disc, no fit), its image's radius in px (0: unknown) and the sectors of the
+  /// outline the centre rests on (blob_t.fit_arc).
   void on_blob(int camera, int64_t utime, bool found, const Eigen::Vector2d& centre,
-               double fit_support = std::nan(""), double radius = 0);
+               double fit_support = std::nan(""), double radius = 0, uint64_t arc = kWholeArc);
 
   bool done() const { return current_ >= stops_.size(); }
   /// "stop 4 of 18: collecting (left 3/10, right 2/10)" and the like.
@@ -149,9 +164,17 @@ class RobotCalibration {
   /// configured offset. Throws
   /// CalibrationInputError when fewer than 6 stops were seen by both cameras.
   /// The pixels are the image's centres, which lie off the projection of the ball's centre off
-  /// the optical axis (sphere_image.hpp); so the solve runs twice, the second time on the pixels
-  /// sphere_centre_pixel() gives with the first solve's cameras and each stop's radius.
+  /// the optical axis, by several px where a circle was fitted to part of the outline of the
+  /// ball's image, an ellipse (sphere_image.hpp). So the solve runs again, each time after the
+  /// first on the measured pixels corrected by the difference between the projection of the
+  /// ball's centre and the centre the tracker's fit finds on the same sectors of the ball's exact
+  /// image, both with the last pass's cameras and offset (sphere_outline_centre; with
+  /// ball_radius 0, sphere_centre_pixel() from each stop's image radius).
   HandEyeSolution solve_hand_eye() const;
+  /// Solves of solve_hand_eye(): the first on the measured pixels, then on corrected ones until
+  /// no correction moves by more than kPixelsSettled (px), at most kMaxPasses in all.
+  static constexpr int kMaxPasses = 12;
+  static constexpr double kPixelsSettled = 0.005;
   /// solve_hand_eye().cameras.
   StereoCalibration solve() const { return solve_hand_eye().cameras; }
 

@@ -36,6 +36,7 @@
 #include "vision/registration.hpp"
 #include "vision/robot_calibration.hpp"
 #include "vision/triangulation.hpp"
+#include "vision/vision_config.hpp"
 
 namespace {
 
@@ -226,6 +227,26 @@ int warn_skipped(const std::vector<sg::vision::CalibrationStop>& stops) {
   return skipped;
 }
 
+/// The three stops the result reprojects worst, with where they are: a stop far worse than the
+/// RMS is one to look at in sg-viewer.
+void print_worst_stops(const sg::vision::RobotCalibration& cal,
+                       const sg::vision::HandEyeSolution& h) {
+  std::vector<std::pair<double, size_t>> worst;
+  for (size_t i = 0; i < h.residual.size(); ++i) {
+    const double r = std::max(h.residual[i][0], h.residual[i][1]);
+    if (std::isfinite(r)) worst.emplace_back(r, i);
+  }
+  std::sort(worst.rbegin(), worst.rend());
+  worst.resize(std::min<size_t>(worst.size(), 3));
+  std::printf("worst stops (%d solves):", h.passes);
+  for (const auto& [r, i] : worst) {
+    const Eigen::Vector3d t = cal.stops()[i].tool;
+    std::printf(" %zu (%.2f, %.2f, %.2f) left %.2f px right %.2f px;", i + 1, t.x(), t.y(), t.z(),
+                h.residual[i][0], h.residual[i][1]);
+  }
+  std::printf("\n");
+}
+
 /// Solves the cameras and the ball's offset on the tool, prints what was found and writes them.
 void solve_and_write(const sg::vision::RobotCalibration& cal, const std::string& out) {
   const int skipped = warn_skipped(cal.stops());
@@ -238,15 +259,17 @@ void solve_and_write(const sg::vision::RobotCalibration& cal, const std::string&
     throw std::runtime_error(e.what());
   }
   const Eigen::Vector3d mm = h.ball_offset * 1e3;
-  h.cameras.source += fmt::format(", ball offset on the tool ({:.1f}, {:.1f}, {:.1f}) mm", mm.x(),
-                                  mm.y(), mm.z());
+  h.cameras.source +=
+      fmt::format(", ball offset on the tool ({:.1f}, {:.1f}, {:.1f}) mm", mm.x(), mm.y(), mm.z());
   std::printf("%zu stops (%d skipped); RMS reprojection error left %.3f px, right %.3f px\n",
               cal.stops().size(), skipped, h.cameras.rms_left, h.cameras.rms_right);
-  std::printf("ball offset on the tool (%.1f, %.1f, %.1f) mm: %s (%d of 3 directions observed; "
-              "RMS reprojection %.3f px as configured, %.3f px estimated); %d blobs left out with "
-              "the ball mostly hidden\n",
-              mm.x(), mm.y(), mm.z(), h.offset_accepted ? "estimated" : "as configured",
-              h.offset_dims, h.rms_configured, h.rms_estimated, hidden);
+  std::printf(
+      "ball offset on the tool (%.1f, %.1f, %.1f) mm: %s (%d of 3 directions observed; "
+      "RMS reprojection %.3f px as configured, %.3f px estimated); %d blobs left out with "
+      "the ball mostly hidden\n",
+      mm.x(), mm.y(), mm.z(), h.offset_accepted ? "estimated" : "as configured", h.offset_dims,
+      h.rms_configured, h.rms_estimated, hidden);
+  print_worst_stops(cal, h);
   sg::vision::write_calibration(out, h.cameras);
   std::printf("wrote %s (robot frame)\n", out.c_str());
 }
@@ -263,7 +286,8 @@ int run_robot(const std::string& url, const sg::vision::RobotCalibrationParams& 
   bus.subscribe<stereograsp::arm_status_t>(
       "ARM_STATUS", [&](const auto& status, const auto&) { arm.on_status(status, cal); });
   bus.subscribe<stereograsp::blob_t>("BLOB_(LEFT|RIGHT)", [&](const auto& b, const auto&) {
-    cal.on_blob(b.camera, b.utime, b.found, {b.centre[0], b.centre[1]}, b.fit_support, b.radius);
+    cal.on_blob(b.camera, b.utime, b.found, {b.centre[0], b.centre[1]}, b.fit_support, b.radius,
+                static_cast<uint64_t>(b.fit_arc));
   });
   std::string last_progress;
   auto last_change = std::chrono::steady_clock::now();
@@ -380,6 +404,8 @@ int main(int argc, char** argv) {
     if (*robot) {
       robot_params.image_width = in.width;
       robot_params.image_height = in.height;
+      // The ball sg-vision looks for: its radius models the ball's image at each stop.
+      robot_params.ball_radius = sg::vision::read_vision_settings(config).match.ball_radius;
       return sg::auth::with_lab_access(app.get_name(), key_options, [&](auto& lab) {
         return run_robot(common.lcm_url, robot_params, in.out, lab);
       });

@@ -22,6 +22,8 @@
 ///     const Eigen::Vector2d px = sphere_centre_pixel(camera, {o.centre.x, o.centre.y}, o.radius);
 
 #include <Eigen/Core>
+#include <cstdint>
+#include <optional>
 
 #include "vision/camera_model.hpp"
 
@@ -31,5 +33,27 @@ namespace sg::vision {
 /// positive and finite or `apparent` is within 1e-6 px of the principal point.
 Eigen::Vector2d sphere_centre_pixel(const CameraModel& camera, const Eigen::Vector2d& apparent,
                                     double radius_px);
+
+/// The centre BallFitter (ball_fit.hpp) finds on the part `arc` (BallFit::arc) of the exact
+/// image of a sphere of radius `radius` (m) centred at `centre` (world frame): the silhouette's
+/// tangent points, O + s (a cos(alpha) + (u cos(phi) + v sin(phi)) sin(alpha)) for the camera
+/// centre O, the unit ray a to the centre, sin(alpha) = radius / |centre - O| and
+/// s = sqrt(|centre - O|^2 - radius^2), projected through the camera (distortion included) at
+/// 720 angles phi. The points in the sectors of `arc` (taken about the whole outline's mean,
+/// then about the first fit's centre) are fitted with BallFitParams{} as the tracker fits the
+/// ball's edge points. Where the gripper hides half the outline of a ball off the optical axis,
+/// a circle fitted to the rest of an ellipse lies several px from the centre's projection; the
+/// difference this model gives is that error, so
+///
+///     pixel of the centre = measured + project(centre) - sphere_outline_centre(...)
+///
+/// With arc = kWholeArc (the tracker's centre is then the region's centroid, eq. 11) it is the
+/// centroid of the area the silhouette encloses: the ellipse's centre, as sphere_centre_pixel()
+/// models it (a circle does not fit a whole ellipse within BallFitter's 1 px). nullopt
+/// when the sphere is not in front of the camera, the camera is inside it, `radius` is not
+/// positive and finite, or fewer than 12 outline points fall in `arc`.
+std::optional<Eigen::Vector2d> sphere_outline_centre(const CameraModel& camera,
+                                                     const Eigen::Vector3d& centre, double radius,
+                                                     uint64_t arc);
 
 }  // namespace sg::vision

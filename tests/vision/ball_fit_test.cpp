@@ -7,10 +7,9 @@
 
 #include <gtest/gtest.h>
 
-#include "tests/support/allocation_counter.hpp"
-
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -21,6 +20,8 @@
 #include <numeric>
 #include <opencv2/imgproc.hpp>
 #include <tuple>
+
+#include "tests/support/allocation_counter.hpp"
 
 namespace sg::vision {
 namespace {
@@ -148,10 +149,36 @@ TEST(BallFitter, WholeDiscsGiveTheirCentreAndRadius) {
       EXPECT_GT(f.support, 0.9) << r << " " << c;
       EXPECT_EQ(f.outside, 0) << r << " " << c;
       EXPECT_GT(f.confidence, 0.7) << r << " " << c;
+      EXPECT_EQ(f.arc, kWholeArc) << r << " " << c << std::hex << " " << f.arc;
     }
   }
   std::printf("whole discs (%d): worst centre error %.3f px, worst radius error %.3f px\n", k,
               worst_centre, worst_radius);
+}
+
+// The sectors of arc: a disc whose top half (y < centre) is hidden rests on the lower half's 32
+// sectors, those of the directions atan2(dy, dx) in [0, pi), bits 32-63, give or take the one
+// at each end of the cut; a quarter left of and below the centre, bits 32-47.
+TEST(BallFitter, ArcMarksTheSectorsTheFitRestsOn) {
+  BallFitter fitter;
+  const cv::Point2d c(100.3, 80.6);
+  const double r = 30;
+  const BallFit half = fitter.fit(
+      edge_of(rasterize(c, r, [&](double, double y) { return y < c.y; })), BallFitParams{});
+  ASSERT_TRUE(half.ok);
+  const uint64_t lower = 0xFFFFFFFF00000000ULL, ends = (1ULL << 32) | (1ULL << 63);
+  EXPECT_EQ(half.arc & ~lower, 0u) << std::hex << half.arc;
+  EXPECT_EQ(half.arc | ends, lower) << std::hex << half.arc;
+  const BallFit quarter =
+      fitter.fit(edge_of(rasterize(c, r, [&](double x, double y) { return y < c.y || x < c.x; })),
+                 BallFitParams{}, r);
+  ASSERT_TRUE(quarter.ok);
+  EXPECT_EQ(quarter.arc & ~0x0000FFFF00000000ULL, 0u) << std::hex << quarter.arc;
+  EXPECT_GE(std::popcount(quarter.arc), 14) << std::hex << quarter.arc;
+  EXPECT_EQ(arc_sector(1, 0), 32);
+  EXPECT_EQ(arc_sector(0, 1), 48);
+  EXPECT_EQ(arc_sector(-1, -1e-9), 0);
+  EXPECT_EQ(arc_sector(-1, 1e-9), 63);
 }
 
 // Discs with 40-60% of their area visible behind a straight occluder edge at many angles: p95

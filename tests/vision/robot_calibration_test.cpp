@@ -10,19 +10,24 @@
 #include <random>
 
 #include "sim/stereo_rig.hpp"
+#include "vision/sphere_image.hpp"
 #include "vision/triangulation.hpp"
 
 namespace sg::vision {
 namespace {
 
+constexpr double kBallRadius = 0.035;  // m, RobotCalibrationParams' default
+
 /// Plays the arm and the cameras: the arm arrives 0.8 s (message time) after each command; the
 /// cameras see the ball at 30 Hz with `noise` px of noise and miss it with probability `drop`.
-/// The ball sits at `offset` (tool frame) from the tool centre point; each blob reports
-/// `fit_support`.
+/// The ball (radius 35 mm) sits at `offset` (tool frame) from the tool centre point; each blob
+/// reports `fit_support` and `arc`, and the centre of the ball's image a tracker finds on those
+/// sectors of its outline (the centroid of the ellipse for a whole disc), not the projection of
+/// the ball's centre.
 HandEyeSolution run_hand_eye(RobotCalibration& cal, double noise, double drop,
                              bool hide_first_stop = false,
                              const Eigen::Vector3d& offset = Eigen::Vector3d::Zero(),
-                             double fit_support = std::nan("")) {
+                             double fit_support = std::nan(""), uint64_t arc = kWholeArc) {
   const auto rig = sim::make_rig({});
   std::mt19937 rng(17);
   std::normal_distribution<double> jitter(0, noise);
@@ -46,8 +51,9 @@ HandEyeSolution run_hand_eye(RobotCalibration& cal, double noise, double drop,
     for (int c = 0; c < 2; ++c) {
       const bool hidden = (hide_first_stop && stop == 1) || unit(rng) < drop;
       const Eigen::Vector2d px =
-          *rig[static_cast<size_t>(c)].project(ball) + Eigen::Vector2d(jitter(rng), jitter(rng));
-      cal.on_blob(c, utime, !hidden, px, fit_support);
+          *sphere_outline_centre(rig[static_cast<size_t>(c)], ball, kBallRadius, arc) +
+          Eigen::Vector2d(jitter(rng), jitter(rng));
+      cal.on_blob(c, utime, !hidden, px, fit_support, 30, arc);
     }
   }
   EXPECT_TRUE(cal.done());
@@ -202,10 +208,11 @@ TEST(RobotCalibration, HandEyeFindsTheBallsOffsetOnTheTool) {
   const HandEyeSolution f = run_hand_eye(fixed, 0.3, 0.0, false, offset);
   EXPECT_EQ(f.ball_offset, Eigen::Vector3d::Zero());
   EXPECT_GT(triangulation_rms(f.cameras), 0.005);
-  std::printf("hand-eye: offset (%.2f, %.2f, %.2f) mm in %d rounds, 3D RMS %.3f mm (%.1f mm "
-              "with the offset taken as zero)\n",
-              h.ball_offset.x() * 1e3, h.ball_offset.y() * 1e3, h.ball_offset.z() * 1e3,
-              h.iterations, triangulation_rms(h.cameras) * 1e3, triangulation_rms(f.cameras) * 1e3);
+  std::printf(
+      "hand-eye: offset (%.2f, %.2f, %.2f) mm in %d rounds, 3D RMS %.3f mm (%.1f mm "
+      "with the offset taken as zero)\n",
+      h.ball_offset.x() * 1e3, h.ball_offset.y() * 1e3, h.ball_offset.z() * 1e3, h.iterations,
+      triangulation_rms(h.cameras) * 1e3, triangulation_rms(f.cameras) * 1e3);
 }
 
 // With the ball where configured, an estimated offset explains no more than the pixels' noise
@@ -233,6 +240,33 @@ TEST(RobotCalibration, ToolDownStopsObserveTheOffsetAcrossTheTool) {
   EXPECT_NEAR(h.ball_offset.y(), 0.004, 1e-3);
   EXPECT_NEAR(h.ball_offset.z(), 0.005, 1e-9);
   EXPECT_LT(triangulation_rms(h.cameras), 0.002);
+}
+
+// Only the lower half of the ball's outline shows at every stop (the palm hides the top): the
+// centre fitted to it lies px off the centre's projection, and modelling that fit on the ball's
+// exact image (sphere_outline_centre) brings the cameras back to where a whole ball puts them;
+// each stop keeps every blob's sectors.
+TEST(RobotCalibration, HalfOutlineIsModelledOnTheBallsImage) {
+  constexpr uint64_t kLowerHalf = 0xFFFFFFFF00000000ULL;  // directions of +y: below the centre
+  RobotCalibration whole({});
+  const double whole_rms = triangulation_rms(run_procedure(whole, 0.3, 0.0));
+  RobotCalibration modelled({});
+  const HandEyeSolution h =
+      run_hand_eye(modelled, 0.3, 0.0, false, Eigen::Vector3d::Zero(), 0.5, kLowerHalf);
+  for (const auto& s : modelled.stops()) {
+    ASSERT_EQ(s.blobs[1].size(), 10u);
+    EXPECT_EQ(s.blobs[1][9].second, kLowerHalf);
+  }
+  RobotCalibrationParams p;
+  p.ball_radius = 0;  // the image's radius only: the ellipse's centre, not the half's fit
+  RobotCalibration unmodelled(p);
+  const HandEyeSolution u =
+      run_hand_eye(unmodelled, 0.3, 0.0, false, Eigen::Vector3d::Zero(), 0.5, kLowerHalf);
+  EXPECT_LT(triangulation_rms(h.cameras), whole_rms + 0.0002);
+  EXPECT_GT(triangulation_rms(u.cameras), 2 * triangulation_rms(h.cameras));
+  std::printf("half outline: 3D RMS %.3f mm modelled, %.3f mm not, %.3f mm whole ball\n",
+              triangulation_rms(h.cameras) * 1e3, triangulation_rms(u.cameras) * 1e3,
+              whole_rms * 1e3);
 }
 
 // Blobs whose fitted circle has too little outline (the gripper hides the ball) are not averaged:
