@@ -155,6 +155,7 @@ Json j_triangulation(const TriangulationSummary& t) {
   return {{"positions", t.positions},
           {"visible", t.visible},
           {"residual_px", j_quantiles(t.residual_px)},
+          {"vs_truth_m", j_quantiles(t.vs_truth_m)},
           {"flag_behind_camera", t.behind_camera},
           {"flag_near_parallel_rays", t.near_parallel},
           {"flag_large_residual", t.large_residual}};
@@ -334,6 +335,12 @@ void md_triangulation(std::ostream& o, const TriangulationSummary& t) {
     << num(t.residual_px.p95) << ", max " << num(t.residual_px.max) << ". Flags: behind camera "
     << t.behind_camera << ", near-parallel rays " << t.near_parallel << ", large residual "
     << t.large_residual << ".\n";
+  const Quantiles& e = t.vs_truth_m;
+  if (e.count > 0) {
+    o << "\nAgainst the simulator's GROUND_TRUTH of the same frame (" << e.count
+      << " positions), mm: p50 " << num(e.p50 * 1e3) << ", p95 " << num(e.p95 * 1e3) << ", RMS "
+      << num(e.rms * 1e3) << ", max " << num(e.max * 1e3) << ".\n";
+  }
 }
 
 /// "Latency" (when measured): per stage, receive time minus the message's own time.
@@ -458,6 +465,12 @@ std::string summary_text(const SessionSummary& s) {
   if (s.wrong_type > 0) o << "problem: " << s.wrong_type << " message(s) of the wrong type\n";
   for (const UnknownChannel& u : s.unknown)
     o << "unknown channel: " << u.name << " (" << u.count << ")\n";
+  const TriangulationSummary& t = s.triangulation;
+  if (t.visible > 0) o << "triangulation: residual p50 " << num(t.residual_px.p50, 3) << " px";
+  if (t.visible > 0 && t.vs_truth_m.count > 0)
+    o << ", " << num(t.vs_truth_m.p50 * 1e3, 2) << " mm p50 from the truth (" << t.vs_truth_m.count
+      << " positions)";
+  if (t.visible > 0) o << "\n";
   for (const HorizonSummary& h : s.prediction)
     if (h.vs_measurement.count > 0 || h.vs_truth.count > 0)
       o << "prediction h=" << h.h << ": RMS " << num(h.vs_measurement.rms, 4)

@@ -281,6 +281,8 @@ struct SessionStats::Impl {
   std::map<std::string, LatencyState> latency;
   TriangulationSummary triangulation;
   LogHistogram residual{1e-4, 1e4, 20};
+  LogHistogram vs_truth{1e-6, 1e3, 20};
+  std::deque<std::pair<int64_t, Vec3>> recent_truths, waiting_positions;  // by capture utime
   Reference measured, truth;
   std::vector<int64_t> predictions;   // per horizon
   std::deque<EpisodeState> episodes;  // stored ones (the first kMaxEpisodes)
@@ -454,6 +456,7 @@ struct SessionStats::Impl {
       if (p.flags & stereograsp::point3_t::FLAG_NEAR_PARALLEL_RAYS) ++triangulation.near_parallel;
       if (p.flags & stereograsp::point3_t::FLAG_LARGE_RESIDUAL) ++triangulation.large_residual;
       if (plots) plots->measured.add(t(p.utime), x);
+      match_truth(waiting_positions, recent_truths, p.utime, x);
     }
     const int64_t gap_us = static_cast<int64_t>(options.occlusion_gap_s * 1e6);
     if (visible) {
@@ -477,6 +480,22 @@ struct SessionStats::Impl {
     if (!finite3(x)) return;
     if (plots) plots->truth.add(t(p.utime), x);
     add_reference_sample(truth, true, p.utime, x);
+    match_truth(recent_truths, waiting_positions, p.utime, x);
+  }
+
+  /// Adds |x - y| to vs_truth for the sample y of `others` taken at `utime`, or keeps x in
+  /// `mine` for one that comes later (the last 512: a log of any size stays in bounded memory).
+  void match_truth(std::deque<std::pair<int64_t, Vec3>>& mine,
+                   std::deque<std::pair<int64_t, Vec3>>& others, int64_t utime, const Vec3& x) {
+    const auto it = std::find_if(others.rbegin(), others.rend(),
+                                 [&](const auto& o) { return o.first == utime; });
+    if (it != others.rend()) {
+      vs_truth.add((it->second - x).norm());
+      others.erase(std::next(it).base());
+      return;
+    }
+    mine.emplace_back(utime, x);
+    if (mine.size() > 512) mine.pop_front();
   }
 
   void on_trajectory(int64_t recv, const stereograsp::trajectory_t& m) {
@@ -807,6 +826,7 @@ void SessionStats::finish() {
   }
   s.triangulation = m.triangulation;
   s.triangulation.residual_px = quantiles(m.residual);
+  s.triangulation.vs_truth_m = quantiles(m.vs_truth);
   s.latency.clear();
   plots_.latency_ms.clear();
   for (auto& [name, l] : m.latency) {

@@ -276,8 +276,12 @@ void RobotCalibration::on_blob(int camera, int64_t utime, bool found, const Eige
   CalibrationStop& stop = stops_[current_];
   const auto c = static_cast<size_t>(camera);
   const bool hidden = found && fit_support < params_.min_fit_support;  // false for NaN
-  if (!found || !centre.allFinite() || hidden) {
+  // Any host can send BLOB_*: a centre off the image is no camera's and is refused.
+  const bool refused = found && !(centre.x() >= -0.5 && centre.x() <= params_.image_width - 0.5 &&
+                                  centre.y() >= -0.5 && centre.y() <= params_.image_height - 0.5);
+  if (!found || refused || hidden) {
     stop.hidden += hidden ? 1 : 0;
+    stop.refused += refused ? 1 : 0;
     if (++stop.misses >= params_.max_misses_per_stop) {
       stop.skipped = true;
       finish_stop();
@@ -286,7 +290,8 @@ void RobotCalibration::on_blob(int camera, int64_t utime, bool found, const Eige
   }
   if (stop.frames[c] >= params_.frames_per_stop) return;
   sums_[c] += centre;
-  radius_sums_[c] += std::isfinite(radius) && radius > 0 ? radius : 0;
+  const bool sized = std::isfinite(radius) && radius > 0 && radius < params_.image_width;
+  radius_sums_[c] += sized ? radius : 0;
   stop.blobs[c].emplace_back(centre, arc);
   ++stop.frames[c];
   if (stop.frames[0] >= params_.frames_per_stop && stop.frames[1] >= params_.frames_per_stop)

@@ -108,7 +108,8 @@ struct CalibrationStop {
   std::array<std::vector<std::pair<Eigen::Vector2d, uint64_t>>, 2> blobs;
   std::array<int, 2> frames{0, 0};
   int misses = 0;
-  int hidden = 0;  ///< blobs left out because the gripper hid too much (min_fit_support)
+  int hidden = 0;   ///< blobs left out because the gripper hid too much (min_fit_support)
+  int refused = 0;  ///< blobs refused: a centre not finite or off the image
   bool skipped = false;
   std::string rejected;  ///< why the arm refused the move (then skipped)
 };

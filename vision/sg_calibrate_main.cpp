@@ -216,6 +216,11 @@ int warn_skipped(const std::vector<sg::vision::CalibrationStop>& stops) {
     if (!s.rejected.empty()) {
       spdlog::warn("stop ({:.3f}, {:.3f}, {:.3f}) skipped: the arm refused it: {}", s.tool.x(),
                    s.tool.y(), s.tool.z(), s.rejected);
+    } else if (s.skipped && s.refused * 2 > s.misses) {
+      spdlog::warn(
+          "stop ({:.3f}, {:.3f}, {:.3f}) skipped: {} blobs with a centre off the image "
+          "(another sender on BLOB_*?)",
+          s.tool.x(), s.tool.y(), s.tool.z(), s.refused);
     } else if (s.skipped && s.hidden * 2 > s.misses) {
       spdlog::warn("stop ({:.3f}, {:.3f}, {:.3f}) skipped: the gripper hid too much of the ball",
                    s.tool.x(), s.tool.y(), s.tool.z());
@@ -250,8 +255,11 @@ void print_worst_stops(const sg::vision::RobotCalibration& cal,
 /// Solves the cameras and the ball's offset on the tool, prints what was found and writes them.
 void solve_and_write(const sg::vision::RobotCalibration& cal, const std::string& out) {
   const int skipped = warn_skipped(cal.stops());
-  int hidden = 0;
-  for (const auto& s : cal.stops()) hidden += s.hidden;
+  int hidden = 0, refused = 0;
+  for (const auto& s : cal.stops()) hidden += s.hidden, refused += s.refused;
+  if (refused > 0)
+    spdlog::warn("{} blobs refused: a centre off the {}x{} image", refused,
+                 cal.params().image_width, cal.params().image_height);
   sg::vision::HandEyeSolution h;
   try {
     h = cal.solve_hand_eye();

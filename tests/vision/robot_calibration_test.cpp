@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "sim/stereo_rig.hpp"
@@ -267,6 +268,41 @@ TEST(RobotCalibration, HalfOutlineIsModelledOnTheBallsImage) {
   std::printf("half outline: 3D RMS %.3f mm modelled, %.3f mm not, %.3f mm whole ball\n",
               triangulation_rms(h.cameras) * 1e3, triangulation_rms(u.cameras) * 1e3,
               whole_rms * 1e3);
+}
+
+// Any host can send BLOB_*: centres off the image, NaN or huge are refused and counted, radii that
+// are no image's are not averaged, and a stop of nothing else is skipped; the calibration from
+// the good blobs around them is as good as without them.
+TEST(RobotCalibration, BlobsNoCameraSentAreRefused) {
+  RobotCalibration cal({});
+  int64_t utime = 1'000'000;
+  const auto t = cal.next_target();
+  ASSERT_TRUE(t);
+  cal.on_arm_status(utime, t->sequence, true);
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector2d& bad :
+       {Eigen::Vector2d(NAN, 10), Eigen::Vector2d(10, inf), Eigen::Vector2d(-1e300, 10),
+        Eigen::Vector2d(640, 10), Eigen::Vector2d(10, -0.6)}) {
+    utime += 1'000'000;
+    cal.on_blob(0, utime, true, bad, 0.9, 1e300, 0);
+  }
+  EXPECT_EQ(cal.stops()[0].refused, 5);
+  EXPECT_EQ(cal.stops()[0].frames[0], 0);
+  for (int k = 0; k < 10; ++k) {
+    utime += 33'333;
+    for (int c = 0; c < 2; ++c) cal.on_blob(c, utime, true, {320, 240}, NAN, 1e300);
+  }
+  EXPECT_EQ(cal.stops()[0].frames[0], 10);
+  EXPECT_EQ(cal.stops()[0].radius[0], 0) << "no image has a ball 1e300 px across";
+  RobotCalibration refusing({});
+  for (int k = 0; !refusing.done() && k < 100000; ++k) {
+    if (auto next = refusing.next_target()) refusing.on_arm_status(utime, next->sequence, true);
+    utime += 33'333;
+    refusing.on_blob(0, utime, true, {1e9, 1e9});
+  }
+  EXPECT_TRUE(refusing.done());
+  for (const auto& s : refusing.stops()) EXPECT_TRUE(s.skipped);
+  EXPECT_THROW(refusing.solve_hand_eye(), CalibrationInputError);
 }
 
 // Blobs whose fitted circle has too little outline (the gripper hides the ball) are not averaged:
