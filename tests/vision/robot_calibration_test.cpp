@@ -61,6 +61,13 @@ HandEyeSolution run_hand_eye(RobotCalibration& cal, double noise, double drop,
   return cal.solve_hand_eye();
 }
 
+/// Commands the first stop and reports the arm there at `utime`.
+void arrive_at_first_stop(RobotCalibration& cal, int64_t utime) {
+  const auto t = cal.next_target();
+  ASSERT_TRUE(t);
+  cal.on_arm_status(utime, t->sequence, true);
+}
+
 StereoCalibration run_procedure(RobotCalibration& cal, double noise, double drop,
                                 bool hide_first_stop = false) {
   return run_hand_eye(cal, noise, drop, hide_first_stop).cameras;
@@ -271,14 +278,12 @@ TEST(RobotCalibration, HalfOutlineIsModelledOnTheBallsImage) {
 }
 
 // Any host can send BLOB_*: centres off the image, NaN or huge are refused and counted, radii that
-// are no image's are not averaged, and a stop of nothing else is skipped; the calibration from
-// the good blobs around them is as good as without them.
+// are no image's are not averaged, and stops of nothing else are skipped: no calibration is made
+// from them.
 TEST(RobotCalibration, BlobsNoCameraSentAreRefused) {
   RobotCalibration cal({});
   int64_t utime = 1'000'000;
-  const auto t = cal.next_target();
-  ASSERT_TRUE(t);
-  cal.on_arm_status(utime, t->sequence, true);
+  arrive_at_first_stop(cal, utime);
   const double inf = std::numeric_limits<double>::infinity();
   for (const Eigen::Vector2d& bad :
        {Eigen::Vector2d(NAN, 10), Eigen::Vector2d(10, inf), Eigen::Vector2d(-1e300, 10),
@@ -310,9 +315,7 @@ TEST(RobotCalibration, BlobsNoCameraSentAreRefused) {
 TEST(RobotCalibration, MostlyHiddenBallIsLeftOut) {
   RobotCalibration cal({});
   int64_t utime = 1'000'000;
-  const auto t = cal.next_target();
-  ASSERT_TRUE(t);
-  cal.on_arm_status(utime, t->sequence, true);
+  arrive_at_first_stop(cal, utime);
   for (int k = 0; k < 200 && cal.stops()[0].frames[0] == 0 && !cal.stops()[0].skipped; ++k) {
     utime += 33'333;
     cal.on_blob(0, utime, true, {320, 240}, 0.3);
