@@ -5,7 +5,10 @@ namespace sg::predictor {
 using stereograsp::trajectory_t;
 
 Measurement measurement_of(const stereograsp::point3_t& m) {
-  return {m.utime, m.visible != 0, {m.position[0], m.position[1], m.position[2]}};
+  return {m.utime,
+          m.visible != 0,
+          {m.position[0], m.position[1], m.position[2]},
+          {m.position_sigma[0], m.position_sigma[1], m.position_sigma[2]}};
 }
 
 trajectory_t to_trajectory_t(const Forecast& f, const PredictorParams& p) {

@@ -17,9 +17,19 @@ const char* model_name(Model m) {
   return m == Model::kBurg ? "burg" : m == Model::kKalman ? "kalman" : "hold";
 }
 
-TrajectoryPredictor::TrajectoryPredictor(const PredictorParams& p) : params_(p) {
+namespace {
+
+/// `p` when its period, horizon and gap are usable (the error model is sized by them).
+const PredictorParams& checked(const PredictorParams& p) {
   if (p.period_us <= 0 || p.horizon < 1 || p.max_gap < 0)
     throw std::invalid_argument("predictor: period, horizon and max_gap must be positive");
+  return p;
+}
+
+}  // namespace
+
+TrajectoryPredictor::TrajectoryPredictor(const PredictorParams& p)
+    : params_(checked(p)), error_(p.horizon, p.max_gap, p.error) {
   if (p.model == Model::kBurg && (p.burg.order < 1 || p.burg.window < p.burg.order + 3))
     throw std::invalid_argument("predictor: the window must hold more than order + 3 samples");
   params_.kalman.period = static_cast<double>(p.period_us) * 1e-6;
@@ -40,6 +50,7 @@ void TrajectoryPredictor::reset() {
   have_seen_ = false;
   occluded_ = 0;
   gating_since_.reset();
+  error_.reset();
 }
 
 Eigen::Vector3d TrajectoryPredictor::one_step() const {
@@ -62,6 +73,7 @@ Forecast TrajectoryPredictor::emit_sample(int64_t grid, const Eigen::Vector3d& v
     occluded_ = 0;
   }
   for (int i = 0; i < 3; ++i) axes_[static_cast<size_t>(i)]->push(value[i], measured);
+  if (measured) error_.score(grid, value, measured_sigma_);
   if (measured) {
     last_real_grid_ = grid;
     last_real_value_ = value;
@@ -84,7 +96,9 @@ Forecast TrajectoryPredictor::emit_sample(int64_t grid, const Eigen::Vector3d& v
   for (int h = 0; h < params_.horizon; ++h) {
     f.positions.emplace_back(axis[0][static_cast<size_t>(h)], axis[1][static_cast<size_t>(h)],
                              axis[2][static_cast<size_t>(h)]);
+    f.sigma.push_back(error_.sigma(h + 1 + occluded_));
   }
+  error_.record(grid, occluded_, f.positions, params_.period_us);
   return f;
 }
 
@@ -157,6 +171,10 @@ std::vector<Forecast> TrajectoryPredictor::add(const Measurement& in) {
   }
   backward_run_ = 0;
   Measurement m = in;
+  // A sigma that is not a sigma (NaN, negative, over a metre) is taken as unknown.
+  measured_sigma_ = (m.sigma.array() >= 0).all() && (m.sigma.array() <= 1).all()
+                        ? m.sigma
+                        : Eigen::Vector3d::Zero();
   if (outside_gate(m)) m.visible = false;
   last_utime_ = m.utime;
   if (!started_) {

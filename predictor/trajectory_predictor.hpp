@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "predictor/axis_model.hpp"
+#include "predictor/forecast_error.hpp"
 
 namespace sg::predictor {
 
@@ -39,6 +40,8 @@ struct PredictorParams {
   /// than this from the newest sample, resets the predictor (m; the track is reported lost and
   /// starts again at the next sighting), so no input can leave it poisoned.
   double reset_distance = 10.0;
+  /// The predictor's estimate of its own error per horizon (forecast_error.hpp).
+  ForecastErrorParams error;
 };
 
 /// One measurement of the ball (OBJECT_POSITION).
@@ -46,6 +49,9 @@ struct Measurement {
   int64_t utime = 0;
   bool visible = false;
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  /// 1-sigma error per axis of position (point3_t.position_sigma, m); zero when unknown. The
+  /// error estimate takes it out of each forecast's error against the measurement.
+  Eigen::Vector3d sigma = Eigen::Vector3d::Zero();
 };
 
 enum class TrackStatus { kNone, kTracking, kOccluded, kLost };
@@ -58,7 +64,10 @@ struct Forecast {
   Eigen::Vector3d sample =
       Eigen::Vector3d::Zero();             ///< the newest grid sample (fed back if occluded)
   std::vector<Eigen::Vector3d> positions;  ///< at utime + h * period_us, h = 1 .. horizon
-  int occluded_samples = 0;                ///< fed-back samples at the end of the history
+  /// 1-sigma error per axis of each position (m): the predictor's own estimate from its past
+  /// forecasts at h + occluded_samples samples past a measurement (ForecastError).
+  std::vector<Eigen::Vector3d> sigma;
+  int occluded_samples = 0;  ///< fed-back samples at the end of the history
   TrackStatus status = TrackStatus::kNone;
 };
 
@@ -67,7 +76,8 @@ struct Forecast {
 /// one-step forecast is fed back as the sample (up to max_gap samples, then the track is lost);
 /// when it is seen again, the fed-back samples are replaced by the line between the last seen
 /// position and the new one, so they do not corrupt the coefficients. Time comes only from the
-/// measurements.
+/// measurements. Each forecast carries the predictor's estimate of its error per point, learned
+/// from its earlier forecasts against the measured samples (ForecastError).
 ///
 ///     TrajectoryPredictor predictor(params);
 ///     for (const Measurement& m : measurements) {
@@ -95,6 +105,8 @@ class TrajectoryPredictor {
   const std::string& last_reset() const { return last_reset_; }
   /// Visible measurements the gate took as not seen.
   uint64_t gated() const { return gated_; }
+  /// Its estimate of its own error per horizon.
+  const ForecastError& error() const { return error_; }
   TrackStatus status() const { return status_; }
   const PredictorParams& params() const { return params_; }
 
@@ -112,6 +124,8 @@ class TrajectoryPredictor {
 
   PredictorParams params_;
   std::array<std::unique_ptr<AxisModel>, 3> axes_;
+  ForecastError error_;
+  Eigen::Vector3d measured_sigma_ = Eigen::Vector3d::Zero();  // of the measurement being added
   uint64_t rejected_ = 0;
   TrackStatus status_ = TrackStatus::kNone;
   bool started_ = false;
@@ -127,7 +141,7 @@ class TrajectoryPredictor {
   uint64_t gated_ = 0;
   uint64_t resets_ = 0;
   std::string last_reset_;
-  int backward_run_ = 0;  // measurements in a row refused as not after the last
+  int backward_run_ = 0;                 // measurements in a row refused as not after the last
   std::optional<int64_t> gating_since_;  // first of the current run of gated measurements
 };
 

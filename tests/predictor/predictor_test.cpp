@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <random>
 #include <sstream>
 
 #include "predictor/burg.hpp"
@@ -230,6 +231,36 @@ TEST(Predictor, OcclusionFeedbackRecoveryAndLoss) {
   const auto again = step(true);
   ASSERT_EQ(again.size(), 1u);
   EXPECT_EQ(again[0].status, TrackStatus::kTracking);
+}
+
+// Every forecast carries a sigma per point: the error model's at h samples past a measurement
+// (h + k for a forecast made k samples into an occlusion), from scores of the predictor's own
+// forecasts on a circle with 2 mm of noise the measurements say they have: the sigma is of the
+// error against the true circle, a fraction of a millimetre at h = 1, and it grows with h.
+TEST(Predictor, ForecastsCarryTheirOwnErrorEstimate) {
+  TrajectoryPredictor predictor(params_4hz());
+  std::mt19937 rng(9);
+  std::normal_distribution<double> noise(0, 0.002);
+  int64_t k = 0;
+  auto step = [&](bool visible) {
+    const double t = static_cast<double>(k) * 0.25;
+    const Eigen::Vector3d seen = circle(t) + Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    return predictor.add({kT0 + k++ * 250'000, visible, seen, Eigen::Vector3d::Constant(0.002)});
+  };
+  for (int i = 0; i < 1200; ++i) step(true);
+  const auto f = step(true);
+  ASSERT_EQ(f.size(), 1u);
+  ASSERT_EQ(f[0].sigma.size(), f[0].positions.size());
+  EXPECT_GT(predictor.error().scores(1), 1000);
+  for (size_t h = 0; h < f[0].sigma.size(); ++h)
+    EXPECT_EQ(f[0].sigma[h], predictor.error().sigma(static_cast<int>(h) + 1)) << h;
+  EXPECT_LT(f[0].sigma[0].maxCoeff(), 0.0015);
+  EXPECT_GT(f[0].sigma[15].x(), f[0].sigma[0].x());
+  step(false);
+  const auto hidden = step(false);
+  ASSERT_EQ(hidden.size(), 1u);
+  ASSERT_EQ(hidden[0].occluded_samples, 2);
+  EXPECT_EQ(hidden[0].sigma[0], predictor.error().sigma(3));
 }
 
 // 30 Hz measurements become samples every 0.25 s exactly, linearly interpolated on utime.
