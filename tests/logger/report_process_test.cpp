@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <lcm/lcm-cpp.hpp>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -22,6 +23,15 @@
 
 namespace sg::test {
 namespace {
+
+/// Events per channel in an lcm-logger file, read with LCM's own reader.
+std::map<std::string, int> events_per_channel(const std::string& path) {
+  lcm::LogFile file(path, "r");
+  std::map<std::string, int> count;
+  if (!file.good()) return count;
+  while (const lcm::LogEvent* e = file.readNextEvent()) ++count[e->channel];
+  return count;
+}
 
 using namespace std::chrono_literals;
 using Json = nlohmann::json;
@@ -214,7 +224,8 @@ TEST_F(ReportProcess, BadInputIsOneLine) {
 }
 
 // A live session: the real sg-predictor fed by this test, recorded by the real lcm-logger; the
-// report counts what was sent and published, and scores the predictions.
+// report counts what the log holds (read by LCM's own reader; at least 90% of what was sent and
+// published), and scores the predictions.
 TEST(ReportLive, RecordedSessionFromTheRealPredictor) {
   ASSERT_TRUE(multicast_available(7922));
   const std::string dir = make_temp_dir();
@@ -272,6 +283,14 @@ TEST(ReportLive, RecordedSessionFromTheRealPredictor) {
   logger.signal(SIGINT);
   ASSERT_FALSE(logger.wait(10s).timed_out);
   ASSERT_GT(published, 10);
+  // What the log holds, by LCM's own reader: a starved lcm-logger loses what LCM's 30-message
+  // subscription queue cannot hold (a loaded machine dropped 1 of 150), so the report is held to
+  // the log, and the log to most of what was sent.
+  const std::map<std::string, int> recorded = events_per_channel(log);
+  const int positions = recorded.count("OBJECT_POSITION") ? recorded.at("OBJECT_POSITION") : 0;
+  const int forecasts = recorded.count("OBJECT_TRAJECTORY") ? recorded.at("OBJECT_TRAJECTORY") : 0;
+  EXPECT_GE(positions, kSent * 9 / 10);
+  EXPECT_GE(forecasts, published * 9 / 10);
 
   const ProcessResult r = run({program("sg-report"), log, "--no-plots"}, 60s);
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -281,9 +300,9 @@ TEST(ReportLive, RecordedSessionFromTheRealPredictor) {
   const Json* traj = find_channel(j, "OBJECT_TRAJECTORY");
   ASSERT_NE(pos, nullptr);
   ASSERT_NE(traj, nullptr);
-  EXPECT_EQ((*pos)["count"], kSent);
-  EXPECT_EQ((*traj)["count"], published);
-  EXPECT_EQ((*traj)["decoded"], published);
+  EXPECT_EQ((*pos)["count"], positions);
+  EXPECT_EQ((*traj)["count"], forecasts);
+  EXPECT_EQ((*traj)["decoded"], forecasts);
   EXPECT_NEAR((*pos)["rate_hz"].get<double>(), 30.0, 3.0);
   // Receive minus capture time: positive, and well under a second on one host.
   const Json& lat = j["latency_ms"]["OBJECT_TRAJECTORY"];
@@ -298,12 +317,12 @@ TEST(ReportLive, RecordedSessionFromTheRealPredictor) {
   const ProcessResult exported =
       run({program("sg-report"), "export", log, "--channel", "OBJECT_TRAJECTORY", "--csv"});
   ASSERT_EQ(exported.exit_code, 0) << exported.err;
-  EXPECT_EQ(count_lines(exported.out), published + 1);
+  EXPECT_EQ(count_lines(exported.out), forecasts + 1);
   const ProcessResult channels = run({program("sg-report"), "channels", log});
-  EXPECT_NE(channels.out.find("OBJECT_POSITION point3_t " + std::to_string(kSent) + " "),
+  EXPECT_NE(channels.out.find("OBJECT_POSITION point3_t " + std::to_string(positions) + " "),
             std::string::npos)
       << channels.out;
-  EXPECT_NE(channels.out.find("OBJECT_TRAJECTORY trajectory_t " + std::to_string(published)),
+  EXPECT_NE(channels.out.find("OBJECT_TRAJECTORY trajectory_t " + std::to_string(forecasts)),
             std::string::npos)
       << channels.out;
 }
