@@ -64,9 +64,8 @@ std::optional<Eigen::Vector2d> mean_fit_error(
 /// The pixels of the ball's centre at each stop from what the images show, with the cameras of
 /// the last pass and the ball at tool + R d: project(X) + the mean of each blob's centre less the
 /// fit the tracker makes on the ball's exact image (sphere_outline_centre), or without a ball
-/// radius the ellipse's
-/// centre correction from the image's radius (sphere_centre_pixel). Returns the most a pixel
-/// moved (px).
+/// radius the ellipse's centre correction from the image's radius (sphere_centre_pixel).
+/// Returns the most a pixel moved (px).
 double correct_pixels(std::vector<Seen>& seen, const std::array<DltResult, 2>& cams,
                       const Eigen::Vector3d& d, double ball_radius) {
   double moved = 0;
