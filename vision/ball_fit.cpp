@@ -231,18 +231,11 @@ bool BallFitter::refine(Circle& c, size_t n, const BallFitParams& p) {
   return true;
 }
 
-uint64_t BallFitter::arc_of(const Circle& c, size_t n, double tolerance) {
-  sector_points_.fill(0);
-  for (size_t i = 0; i < n; ++i) {
-    const double dx = xs_[i] - c.x, dy = ys_[i] - c.y;
-    if (std::abs(std::sqrt(dx * dx + dy * dy) - c.r) > tolerance) continue;
-    uint16_t& k = sector_points_[static_cast<size_t>(arc_sector(dx, dy))];
-    k = static_cast<uint16_t>(std::min(k + 1, 65535));
-  }
+uint64_t BallFitter::arc_of(double r) const {
   // A whole outline has at least 1 edge point per px of arc (4-neighbour midpoints: |cos| + |sin|
   // per px); half of that marks a sector seen, and a lone empty sector between two seen ones is
   // a gap of the pixel grid (a small circle's sectors hold one point or none), not of the arc.
-  const double half = 0.5 * (2 * M_PI * c.r / kArcSectors);
+  const double half = 0.5 * (2 * M_PI * r / kArcSectors);
   uint64_t arc = 0;
   for (int k = 0; k < kArcSectors; ++k) {
     if (sector_points_[static_cast<size_t>(k)] >= std::max(1.0, half)) arc |= uint64_t{1} << k;
@@ -259,6 +252,7 @@ BallFit BallFitter::describe(const Circle& c, size_t n, const BallFitParams& p) 
   const int bins =
       std::clamp(static_cast<int>(2 * M_PI * c.r / std::max(p.support_bin, 1e-3)), 8, kMaxBins);
   std::fill(bins_.begin(), bins_.begin() + bins, uint8_t{0});
+  sector_points_.fill(0);
   double sum2 = 0;
   for (size_t i = 0; i < n; ++i) {
     const double dx = xs_[i] - c.x, dy = ys_[i] - c.y;
@@ -268,11 +262,14 @@ BallFit BallFitter::describe(const Circle& c, size_t n, const BallFitParams& p) 
     ++f.inliers, sum2 += e * e;
     const double t = turn_fraction(dy, dx);  // 0..1
     bins_[static_cast<size_t>(std::clamp(static_cast<int>(t * bins), 0, bins - 1))] = 1;
+    uint16_t& k = sector_points_[static_cast<size_t>(  // arc_sector(dx, dy), t already known
+        std::clamp(static_cast<int>(t * kArcSectors), 0, kArcSectors - 1))];
+    k = static_cast<uint16_t>(std::min(k + 1, 65535));
   }
   int covered = 0;
   for (int b = 0; b < bins; ++b) covered += bins_[static_cast<size_t>(b)];
   f.support = static_cast<double>(covered) / bins;
-  f.arc = arc_of(c, n, p.inlier_tolerance);
+  f.arc = arc_of(c.r);
   f.rms = f.inliers > 0 ? std::sqrt(sum2 / f.inliers) : 0.0;
   const double out_share = static_cast<double>(f.outside) / static_cast<double>(n);
   const double q = f.rms / p.confidence_rms_scale;

@@ -157,7 +157,7 @@ class BallFitter {
   bool kasa(Circle& c, size_t m) const;
   bool gauss_newton(Circle& c, size_t m, int steps) const;
   BallFit describe(const Circle& c, size_t n, const BallFitParams& p);
-  uint64_t arc_of(const Circle& c, size_t n, double tolerance);
+  uint64_t arc_of(double r) const;  ///< BallFit::arc from sector_points_, filled by describe()
 
   size_t max_points_;
   cv::Point2d offset_;                              // mean of the points used

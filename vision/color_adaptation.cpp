@@ -62,7 +62,8 @@ bool ColorAdaptation::sample(const cv::Mat& bgr, const cv::Point2d& centre, doub
       pixels_[2].push_back(static_cast<float>(px[0]) / static_cast<float>(sum));
     }
   }
-  return static_cast<int>(pixels_[0].size()) >= p_.min_pixels;
+  // Never an empty sample, whatever min_pixels says: quantile_of needs a pixel.
+  return !pixels_[0].empty() && static_cast<int>(pixels_[0].size()) >= p_.min_pixels;
 }
 
 bool ColorAdaptation::learn(const cv::Mat& bgr, const cv::Point2d& centre, double radius) {
