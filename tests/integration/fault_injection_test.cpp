@@ -200,12 +200,12 @@ TEST_F(FaultInjection, KillGraspHoldingTheBall) {
           "restarted sg-grasp: q3 hand closed, idle"});
 }
 
-// kill -9 of sg-grasp in the middle of a long move (HOME at 10% speed): the driver's watchdog
+// kill -9 of sg-grasp in the middle of a long move (HOME at 5% speed): the driver's watchdog
 // sends ABORT (the gripper kept) within the silence plus one interaction of sg-grasp's last
 // message, and the arm stops there.
 TEST_F(FaultInjection, KillGraspDuringALongMove) {
   FaultLoop::Options slow;
-  slow.grasp_args = {"--speed", "0.1"};
+  slow.grasp_args = {"--speed", "0.05"};  // 0.79 rad from READY: about 5 s
   auto loop = tracking_loop(7954, slow);
   ASSERT_FALSE(HasFailure()) << loop->logs();
   ASSERT_EQ(loop->grasp_ctl({"home"}, 30s).exit_code, 0);
@@ -225,7 +225,7 @@ TEST_F(FaultInjection, KillGraspDuringALongMove) {
   const double abort_after = (audit.aborts.back() - last) * 1e-6;
   EXPECT_GE(abort_after, kCommanderTimeout - 0.05);
   EXPECT_LE(abort_after, kStopBound);
-  record({"kill -9 sg-grasp", "a long move (HOME at 10% speed)",
+  record({"kill -9 sg-grasp", "a long move (HOME at 5% speed)",
           "ABORT " + seconds(abort_after) + " after its last message, at rest " + seconds(delay),
           log_summary(audit), "ARM_STATUS.watchdog \"" + loop->seen().arm().watchdog + "\""});
 }

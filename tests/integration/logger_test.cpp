@@ -29,7 +29,7 @@ class LoggerTest : public ::testing::Test {
     dir_ = make_temp_dir();
     log_path_ = dir_ + "/session.lcmlog";
     Child logger({SG_LCM_LOGGER, "--lcm-url=" + test_url(7902), "-c", "BUS_CHECK_.*", log_path_});
-    ASSERT_TRUE(eventually([&] { return joined_bus(logger.pid(), 7902); }, 30s,
+    ASSERT_TRUE(eventually([&] { return listening_on_bus(logger.pid(), 7902); }, 30s,
                            "lcm-logger to join the bus"));
     Bus observer(test_url(7902));  // hears what the logger hears
     int heard = 0;
@@ -100,7 +100,7 @@ TEST_F(LoggerTest, LogplayerReplaysToASubscriber) {
   ASSERT_TRUE(multicast_available(7903));
   Child receiver({program("sg-bus-check"), "receive", "--count", std::to_string(kCount),
                   "--timeout", "10", "--lcm-url", test_url(7903)});
-  ASSERT_TRUE(eventually([&] { return joined_bus(receiver.pid(), 7903); }, 30s,
+  ASSERT_TRUE(eventually([&] { return listening_on_bus(receiver.pid(), 7903); }, 30s,
                          "the receiver to join the bus"));
   const ProcessResult player =
       run({SG_LCM_LOGPLAYER, "-s", "4", "-l", test_url(7903), log_path_}, 60s);

@@ -48,9 +48,9 @@ TEST(Predictor, ReplayedLogGivesIdenticalTrajectories) {
   // Capture times of 2023 (so a replay is the same): the gate on the receiver's clock is off.
   Child live({program("sg-predictor"), "--lcm-url", test_url(7914), "--max-time-offset", "0"});
   Child logger({SG_LCM_LOGGER, "--lcm-url=" + test_url(7914), "-c", "OBJECT_POSITION", log});
-  ASSERT_TRUE(
-      eventually([&] { return joined_bus(live.pid(), 7914) && joined_bus(logger.pid(), 7914); },
-                 30s, "sg-predictor and lcm-logger to join the bus"));
+  ASSERT_TRUE(eventually(
+      [&] { return listening_on_bus(live.pid(), 7914) && listening_on_bus(logger.pid(), 7914); },
+      30s, "sg-predictor and lcm-logger to join the bus"));
 
   sim::ScenarioParams sp;
   sp.phase = 0.3;
@@ -83,9 +83,8 @@ TEST(Predictor, ReplayedLogGivesIdenticalTrajectories) {
       << live_done.out << live_done.err;
   ASSERT_EQ(live_out.size(), static_cast<size_t>(kSamples));
 
-  Child replayed(
-      {program("sg-predictor"), "--lcm-url", test_url(7915), "--max-time-offset", "0"});
-  ASSERT_TRUE(eventually([&] { return joined_bus(replayed.pid(), 7915); }, 30s,
+  Child replayed({program("sg-predictor"), "--lcm-url", test_url(7915), "--max-time-offset", "0"});
+  ASSERT_TRUE(eventually([&] { return listening_on_bus(replayed.pid(), 7915); }, 30s,
                          "the replayed sg-predictor to join the bus"));
   Bus b(test_url(7915));
   listen(b, replay_out);

@@ -18,7 +18,7 @@ TEST(Udpm, ThousandMessagesAt100HzBetweenProcessesNoneLost) {
   const std::string url = test_url(kPort);
   Child receiver(
       {program("sg-bus-check"), "receive", "--count", "1000", "--timeout", "10", "--lcm-url", url});
-  ASSERT_TRUE(eventually([&] { return joined_bus(receiver.pid(), kPort); }, 30s,
+  ASSERT_TRUE(eventually([&] { return listening_on_bus(receiver.pid(), kPort); }, 30s,
                          "the receiver to join the bus"));
   const ProcessResult sender = run(
       {program("sg-bus-check"), "send", "--count", "1000", "--rate", "100", "--lcm-url", url}, 60s);

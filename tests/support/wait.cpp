@@ -172,6 +172,8 @@ bool idle(pid_t pid) {
   return all_threads_in(pid, 'S');
 }
 
+bool listening_on_bus(pid_t pid, int port) { return joined_bus(pid, port) && idle(pid); }
+
 bool stopped(pid_t pid) { return all_threads_in(pid, 'T'); }
 
 bool handled_bus(pid_t pid, int port) {

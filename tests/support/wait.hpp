@@ -53,6 +53,13 @@ void handle_for(Bus& bus, std::chrono::milliseconds duration);
 /// anything; the join is the system call after the bind).
 bool joined_bus(pid_t pid, int port);
 
+/// joined_bus() and then idle(): `pid` has joined the bus and has gone to sleep waiting for
+/// messages, so its handlers are in place. LCM's lcm_subscribe() binds and joins (in the
+/// provider) before it registers the handler, and udpm's receive thread drops a datagram on a
+/// channel with no handler: a message sent the moment joined_bus() turns true can be lost. Use
+/// this before sending a finite stream whose every message must arrive.
+bool listening_on_bus(pid_t pid, int port);
+
 /// True when process `pid` has taken every datagram that reached its socket on udpm port `port`
 /// off that socket (its receive queue is empty): once this test has itself received the last
 /// message sent, the other subscriber has read it too. Read, not yet handled: LCM passes it to the
