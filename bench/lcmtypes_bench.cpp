@@ -32,6 +32,7 @@ trajectory_t make_trajectory() {
   trajectory_t t{};
   t.num_points = 16;
   t.position.assign(16, std::vector<double>{0.5, 0.1, 0.2});
+  t.position_sigma.assign(16, std::vector<double>{0.001, 0.001, 0.001});
   return t;
 }
 

@@ -81,6 +81,7 @@ std::vector<uint8_t> trajectory(int64_t u, bool visible) {
   for (int k = 0; k < 16; ++k) {
     const auto p = circle(t.start_utime + k * t.period_us);
     t.position.push_back({p[0], p[1], p[2] + 0.002 * k});
+    t.position_sigma.push_back({0.001, 0.001, 0.001});
   }
   t.status = visible ? 1 : 2;
   t.model = 1;

@@ -118,6 +118,11 @@ void fill(trajectory_t& m, Pattern& p) {
     point.resize(3);  // lcm-gen's C++ for [n][3] is a vector of vectors: size each one
     for (double& v : point) v = p.real();
   }
+  m.position_sigma.resize(static_cast<size_t>(m.num_points));
+  for (auto& sigma : m.position_sigma) {
+    sigma.resize(3);
+    for (double& v : sigma) v = p.real();
+  }
   m.occluded_samples = p.below(17);
   m.status = p.small();
   m.model = p.small();

@@ -51,8 +51,8 @@ template <class M, class V>
   requires std::same_as<std::remove_const_t<M>, stereograsp::trajectory_t>
 void visit_fields(M& m, V& v) {
   SG_FIELD(utime); SG_FIELD(source_utime); SG_FIELD(start_utime); SG_FIELD(period_us);
-  SG_FIELD(num_points); SG_FIELD(position); SG_FIELD(occluded_samples); SG_FIELD(status);
-  SG_FIELD(model); SG_FIELD(model_order);
+  SG_FIELD(num_points); SG_FIELD(position); SG_FIELD(position_sigma);
+  SG_FIELD(occluded_samples); SG_FIELD(status); SG_FIELD(model); SG_FIELD(model_order);
 }
 template <class M, class V>
   requires std::same_as<std::remove_const_t<M>, stereograsp::arm_cmd_t>

@@ -55,7 +55,9 @@ template <>
 struct WireLimits<stereograsp::trajectory_t> {
   static constexpr int64_t kMaxString = 4096;
   /// The predictor forecasts 16 samples by default; other tools' paths may be longer.
-  static std::vector<VariableArray> arrays() { return {{"position", "num_points", 65536, 3}}; }
+  static std::vector<VariableArray> arrays() {
+    return {{"position", "num_points", 65536, 3}, {"position_sigma", "num_points", 65536, 3}};
+  }
 };
 template <>
 struct WireLimits<stereograsp::image_t> {

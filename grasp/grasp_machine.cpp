@@ -172,6 +172,7 @@ CommandReply GraspMachine::grasp(const std::string& where, int64_t now) {
   }
   status_.state = GraspState::kApproaching;
   status_.activity = GraspActivity::kGrasping;
+  grasp_utime_ = now;
   status_.last_action = GraspAction::kApproachObject;
   status_.outcome = GraspOutcome::kNone;
   if (next_ == NextAction::kHome) next_ = NextAction::kNone;
@@ -449,19 +450,12 @@ std::optional<ArmRequest> GraspMachine::aim(Kind kind, int64_t now) {
     return std::nullopt;
   }
   bool approach = kind == Kind::kApproach;
-  Eigen::Vector3d offset(0, 0, approach ? 0.0 : settings_.standoff);
-  Interception aim = intercept(geometry_, *path, arm_.joints, now, delay_, approach ? delay_ : 0.0,
-                               offset, settings_.speed, settings_.interception);
-  // The CLOSE travelling with the approach executes one delay after the motion starts: when the
-  // motion takes longer, the hand would close short of the ball. Close in first, above the ball
-  // as when tracking (still q1), and approach from there.
-  if (approach && aim.ok &&
-      motion_time(geometry_, arm_.joints, aim.joints, settings_.speed) > delay_) {
-    approach = false;
+  Interception aim = intercept_for(*path, approach, now);
+  std::string note;
+  if (approach && aim.ok && !ready_to_close(*path, aim, now, &note)) {
+    approach = false;  // above the ball as when tracking (still q1), and approach from there
     kind = Kind::kTrack;
-    offset = Eigen::Vector3d(0, 0, settings_.standoff);
-    aim = intercept(geometry_, *path, arm_.joints, now, delay_, 0.0, offset, settings_.speed,
-                    settings_.interception);
+    aim = intercept_for(*path, false, now);
   }
   if (!aim.ok) {
     refuse("target refused: " + aim.error);
@@ -474,6 +468,7 @@ std::optional<ArmRequest> GraspMachine::aim(Kind kind, int64_t now) {
   }
   std::optional<ArmRequest> r = cartesian(kind, aim.pose.position, aim.pose.rpy,
                                           approach ? Cmd::GRIPPER_CLOSE : Cmd::GRIPPER_KEEP, now);
+  if (!note.empty()) set_message(note);
   r->source_utime = source_utime;
   r->target_utime = aim.arrival_utime;
   status_.target_utime = aim.arrival_utime;
@@ -483,6 +478,50 @@ std::optional<ArmRequest> GraspMachine::aim(Kind kind, int64_t now) {
     approach_rpy_ = aim.pose.rpy;
   }
   return r;
+}
+
+Interception GraspMachine::intercept_for(const PredictedPath& path, bool approach,
+                                         int64_t now) const {
+  const Eigen::Vector3d offset(0, 0, approach ? 0.0 : settings_.standoff);
+  return intercept(geometry_, path, arm_.joints, now, delay_, approach ? delay_ : 0.0, offset,
+                   settings_.speed, settings_.interception);
+}
+
+bool GraspMachine::ready_to_close(const PredictedPath& path, const Interception& aim, int64_t now,
+                                  std::string* note) const {
+  note->clear();
+  // The CLOSE travelling with the approach executes one delay after the motion starts: when the
+  // motion takes longer, the hand would close short of the ball. Close in first.
+  if (motion_time(geometry_, arm_.joints, aim.joints, settings_.speed) > delay_) return false;
+  const std::optional<double> sigma = close_sigma(path, aim.arrival_utime);
+  if (!sigma) return true;  // no estimate: the baseline's hold path
+  const double bound = settings_.confidence * *sigma;
+  const std::string sure = fixed(settings_.confidence, 1) + " sigma " + fixed(bound * 1e3, 1) +
+                           " mm " + (bound <= settings_.tolerance ? "<=" : ">") + " " +
+                           fixed(settings_.tolerance * 1e3, 1) + " mm tolerance";
+  if (bound <= settings_.tolerance) {
+    *note = "closing: " + sure;
+    return true;
+  }
+  const double left = settings_.max_wait - 1e-6 * static_cast<double>(now - grasp_utime_);
+  if (left <= 0) {
+    *note = "closing on a guess after " + fixed(settings_.max_wait, 1) + " s: " + sure;
+    return true;
+  }
+  *note = "waiting to close: " + sure + " (" + fixed(left, 1) + " s left)";
+  return false;
+}
+
+std::optional<double> GraspMachine::close_sigma(const PredictedPath& path, int64_t t) const {
+  const std::optional<Eigen::Vector3d> sigma = path.sigma_at(t);
+  if (!sigma) return std::nullopt;
+  double speed = 0;  // |p'(t)|, a central difference over one period where the path has it
+  const int64_t half = path.period_us / 2;
+  const auto before = path.at(t - half), after = path.at(t + half);
+  if (before && after && half > 0) speed = (*after - *before).norm() / (2e-6 * half);
+  const double timing = speed * settings_.timing_sigma;
+  return std::sqrt(sigma->squaredNorm() + settings_.arm_sigma * settings_.arm_sigma +
+                   timing * timing);
 }
 
 std::optional<ArmRequest> GraspMachine::cartesian(Kind kind, const Eigen::Vector3d& position,

@@ -33,8 +33,8 @@
 /// request in flight (the driver restarted; the old one may have executed it), the request is
 /// not resent: it is abandoned as failed ("driver restarted") and the next one is computed afresh
 /// under a new sequence. So is one in flight when ARM_STATUS shows a new watchdog stop (the
-/// driver's STOP replaced the command it held). A request with no answer for kAnswerTimeout (or 8 delays, whichever is
-/// longer) since it was first sent is given up and treated as failed.
+/// driver's STOP replaced the command it held). A request with no answer for kAnswerTimeout (or 8
+/// delays, whichever is longer) since it was first sent is given up and treated as failed.
 ///
 /// Rejections are backed off. After the k-th consecutive rejection (reset when a request is
 /// executed) the next request waits min(kRetryFirst * 2^(k-1), kRetryLongest): 0.25, 0.5, 1, 2,
@@ -62,6 +62,20 @@
 /// message in status()) when intercept() fails or the target is below table_z + table_margin or
 /// outside the workspace box; the machine stays where it is and tries again on the next
 /// take_request().
+///
+/// Closing when sure (issue 17). The approach carries the CLOSE, so it is sent only when the
+/// interception is sure enough: with the path's own 1-sigma error at the arrival time T
+/// (PredictedPath::sigma_at, the predictor's estimate), the arm's and the calibration's error
+/// arm_sigma, and the controller's timing spread timing_sigma times the ball's predicted speed,
+///
+///     sigma_close = sqrt(|sigma(T)|^2 + arm_sigma^2 + (|p'(T)| timing_sigma)^2),
+///
+/// the approach goes when confidence * sigma_close <= tolerance (2 x 10 mm for the 20 mm the
+/// gripper forgives). Otherwise the arm keeps tracking above the ball in q1 and tries again at
+/// the next take_request(), status().message saying "waiting to close: 2 sigma 31 mm > 20 mm
+/// tolerance (5.2 s left)"; an occlusion then ends before the hand closes. At max_wait after the
+/// grasp command it closes on its best guess, and says so. A path without sigmas (the
+/// --no-prediction baseline) closes at once, as before.
 ///
 /// Transitions: the state and activity after the command and the request it makes (sent by
 /// take_request()); a refused or ignored command changes nothing but status().message.
@@ -274,6 +288,12 @@ struct GraspSettings {
   double heartbeat_period = 0.2;    ///< s between MODE_HEARTBEAT while the arm is wanted
   double resend_after = 0.5;        ///< s: a request ARM_STATUS does not show received is resent
   double arm_status_timeout = 1.0;  ///< s without ARM_STATUS: no request, no heartbeat
+  /// When to close (see "Closing when sure" in the file comment).
+  double tolerance = 0.02;      ///< m: ball centre to tool centre at the close that still grasps
+  double confidence = 2.0;      ///< sigmas of the close's error that must fit in `tolerance`
+  double arm_sigma = 0.001;     ///< m, 3D: the arm's and the calibration's error at the tool
+  double timing_sigma = 0.035;  ///< s: the spread of the controller's delay (0.72-0.84 s uniform)
+  double max_wait = 8.0;        ///< s after the grasp command: then close on the best guess
   InterceptionSettings interception;
   InputGate input_gate;
 };
@@ -441,6 +461,14 @@ class GraspMachine {
   std::optional<ArmRequest> cartesian(Kind kind, const Eigen::Vector3d& position,
                                       const Eigen::Vector3d& rpy, int8_t gripper, int64_t now);
   std::optional<ArmRequest> aim(Kind kind, int64_t now);
+  /// intercept() for tracking (the stand-off, after_start 0) or the approach (after one delay).
+  Interception intercept_for(const PredictedPath& path, bool approach, int64_t now) const;
+  /// Whether the approach `aim` may carry the CLOSE now (its motion fits one delay, and
+  /// "Closing when sure" above); `note` gets the message either way ("" when nothing to say).
+  bool ready_to_close(const PredictedPath& path, const Interception& aim, int64_t now,
+                      std::string* note) const;
+  /// sigma_close at `t` (m), nullopt when `path` carries no sigmas.
+  std::optional<double> close_sigma(const PredictedPath& path, int64_t t) const;
 
   ArmGeometry geometry_;
   GraspSettings settings_;
@@ -456,6 +484,7 @@ class GraspMachine {
   int64_t path_source_utime_ = 0;
   std::optional<Eigen::Vector3d> measured_;  ///< last visible measurement
   int64_t measured_utime_ = 0;
+  int64_t grasp_utime_ = 0;  ///< when the grasp in progress was asked for (max_wait)
 
   std::optional<InFlight> in_flight_;
   std::map<int64_t, int> motion_commands_;  ///< sequence -> motion commands, for the delay

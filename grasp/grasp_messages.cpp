@@ -77,8 +77,8 @@ std::optional<PredictedPath> convert(const stereograsp::trajectory_t& m, Traject
   }
   if (m.num_points < 0 || static_cast<size_t>(m.num_points) != m.position.size()) {
     return refuse(TrajectoryRefusal::kMalformed, "num_points " + std::to_string(m.num_points) +
-                                                     " for " +
-                  std::to_string(m.position.size()) + " points");
+                                                     " for " + std::to_string(m.position.size()) +
+                                                     " points");
   }
   for (const auto& q : m.position) {
     if (q.size() == 3 && std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2])) {
@@ -89,6 +89,20 @@ std::optional<PredictedPath> convert(const stereograsp::trajectory_t& m, Traject
       return refuse(TrajectoryRefusal::kNonFinite,
                     "point " + std::to_string(p.points.size()) + " is not 3 finite numbers");
     }
+  }
+  if (m.position_sigma.size() != m.position.size()) {
+    return refuse(TrajectoryRefusal::kMalformed, std::to_string(m.position_sigma.size()) +
+                                                     " sigmas for " +
+                                                     std::to_string(m.position.size()) + " points");
+  }
+  for (size_t i = 0; i < p.points.size(); ++i) {  // a lost track's NaNs are cut off above
+    const auto& s = m.position_sigma[i];
+    if (s.size() != 3 || !(s[0] >= 0 && s[1] >= 0 && s[2] >= 0) ||
+        !(std::isfinite(s[0]) && std::isfinite(s[1]) && std::isfinite(s[2]))) {
+      return refuse(TrajectoryRefusal::kNonFinite,
+                    "sigma " + std::to_string(i) + " is not 3 finite numbers >= 0");
+    }
+    p.sigmas.emplace_back(s[0], s[1], s[2]);
   }
   return p;
 }
@@ -145,8 +159,8 @@ std::optional<std::pair<TrajectoryRefusal, std::string>> header_problem(
   }
   if (m.num_points > kMaxTrajectoryPoints) {
     return std::pair{R::kTooManyPoints, "num_points " + std::to_string(m.num_points) +
-                                            " (at most " +
-                                            std::to_string(kMaxTrajectoryPoints) + ")"};
+                                            " (at most " + std::to_string(kMaxTrajectoryPoints) +
+                                            ")"};
   }
   for (const auto& [name, t] : {std::pair{"utime", m.utime}, {"start_utime", m.start_utime}}) {
     if (std::string p = time_problem(name, t, now, gate.max_time_offset); !p.empty()) {

@@ -26,6 +26,17 @@ GraspSettings read_grasp_settings(const Config& config) {
            "s: a request that ARM_STATUS does not show received is sent again (same sequence)");
   g.number("arm_status_timeout", s.arm_status_timeout, Range::closed(0.1, 60),
            "s without ARM_STATUS: no request and no heartbeat until it returns");
+  g.number("tolerance", s.tolerance, Range::above_to(0, 0.5),
+           "m: the ball centre this close to the tool centre at the close still grasps");
+  g.number("confidence", s.confidence, Range::closed(0, 10),
+           "sigmas of the close's predicted error that must fit in the tolerance (0: close "
+           "at once)");
+  g.number("arm_sigma", s.arm_sigma, Range::closed(0, 0.5),
+           "m: the arm's and the calibration's 1-sigma error at the tool (3D)");
+  g.number("timing_sigma", s.timing_sigma, Range::closed(0, 5),
+           "s: the 1-sigma spread of the controller's delay per interaction");
+  g.number("max_wait", s.max_wait, Range::closed(0, 600),
+           "s after the grasp command: close on the best guess when no interception was sure");
   g.flag("use_prediction", s.use_prediction,
          "false: aim at the last measured position (the baseline)");
   g.number("table_z", i.table_z, Range::closed(-2, 2), "m: the table top in the robot's frame");

@@ -9,11 +9,11 @@
 
 namespace sg::grasp {
 
-using arm::rpy_from_rotation;
 using arm::IkResult;
-using arm::solve_nearest;
-using arm::pose_from_xyz_rpy;
 using arm::motion_time;
+using arm::pose_from_xyz_rpy;
+using arm::rpy_from_rotation;
+using arm::solve_nearest;
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -61,20 +61,40 @@ int64_t PredictedPath::end_utime() const {
   return start_utime + static_cast<int64_t>(points.size() - 1) * period_us;
 }
 
-std::optional<Eigen::Vector3d> PredictedPath::at(int64_t t) const {
-  if (lost || points.empty() || t < utime || t > end_utime()) return std::nullopt;
-  if (points.size() == 1) return points[0];
-  if (period_us <= 0) return std::nullopt;  // malformed: the points have no times
-  const int64_t since = t - start_utime;
-  if (since < 0) {  // back-extension along the first segment (a negative fraction)
-    const double f = static_cast<double>(since) / static_cast<double>(period_us);
-    return Eigen::Vector3d(points[0] + f * (points[1] - points[0]));
+namespace {
+
+/// values[] (one per point of `path`) at `t`, linearly interpolated; before start_utime the first
+/// segment extended back when `extend_back`, else values[0].
+std::optional<Eigen::Vector3d> interpolate(const PredictedPath& path,
+                                           const std::vector<Eigen::Vector3d>& values, int64_t t,
+                                           bool extend_back) {
+  if (path.lost || values.empty() || values.size() != path.points.size() || t < path.utime ||
+      t > path.end_utime()) {
+    return std::nullopt;
   }
-  const auto i = static_cast<std::size_t>(since / period_us);
-  const int64_t rest = since % period_us;
-  if (rest == 0) return points[i];  // exactly at a point (includes the last one)
-  const double f = static_cast<double>(rest) / static_cast<double>(period_us);
-  return Eigen::Vector3d(points[i] + f * (points[i + 1] - points[i]));
+  if (values.size() == 1) return values[0];
+  if (path.period_us <= 0) return std::nullopt;  // malformed: the points have no times
+  const int64_t since = t - path.start_utime;
+  if (since < 0) {  // back-extension along the first segment (a negative fraction)
+    if (!extend_back) return values[0];
+    const double f = static_cast<double>(since) / static_cast<double>(path.period_us);
+    return Eigen::Vector3d(values[0] + f * (values[1] - values[0]));
+  }
+  const auto i = static_cast<std::size_t>(since / path.period_us);
+  const int64_t rest = since % path.period_us;
+  if (rest == 0) return values[i];  // exactly at a point (includes the last one)
+  const double f = static_cast<double>(rest) / static_cast<double>(path.period_us);
+  return Eigen::Vector3d(values[i] + f * (values[i + 1] - values[i]));
+}
+
+}  // namespace
+
+std::optional<Eigen::Vector3d> PredictedPath::at(int64_t t) const {
+  return interpolate(*this, points, t, /*extend_back=*/true);
+}
+
+std::optional<Eigen::Vector3d> PredictedPath::sigma_at(int64_t t) const {
+  return interpolate(*this, sigmas, t, /*extend_back=*/false);
 }
 
 // The lean. Let e_r = (cos az, sin az, 0) be the horizontal unit vector from the base axis

@@ -37,6 +37,9 @@ struct PredictedPath {
   int64_t start_utime = 0;      ///< time of points[0] (normally utime + period_us)
   int64_t period_us = 250'000;  ///< 4 Hz
   std::vector<Eigen::Vector3d> points;
+  /// The 1-sigma error of each point per axis (trajectory_t.position_sigma), m: empty when the
+  /// path's maker gave none, else as many as points.
+  std::vector<Eigen::Vector3d> sigmas;
   bool lost = false;  ///< the predictor has lost the track: no target from this path
 
   /// A path that stays at `position` (the --no-prediction baseline: aim at the last measurement).
@@ -50,6 +53,11 @@ struct PredictedPath {
   /// the line through points[0] and points[1] extended back (points[0] when there is one point);
   /// nullopt before utime, after end_utime(), or for an empty or lost path.
   std::optional<Eigen::Vector3d> at(int64_t t) const;
+
+  /// The 1-sigma error per axis at `t`: linear interpolation between the points' sigmas, and
+  /// sigmas[0] from utime to start_utime (no extrapolation toward zero); nullopt where at() is,
+  /// or when the path carries no sigmas.
+  std::optional<Eigen::Vector3d> sigma_at(int64_t t) const;
 };
 
 /// Where the tool must go and how it is turned.

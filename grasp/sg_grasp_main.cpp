@@ -16,13 +16,13 @@
 #include <chrono>
 
 #include "auth/lab_access.hpp"
-#include "grasp/grasp_machine.hpp"
-#include "grasp/grasp_node.hpp"
-#include "grasp/grasp_settings.hpp"
 #include "common/bus.hpp"
 #include "common/clock.hpp"
 #include "common/program.hpp"
 #include "common/shutdown.hpp"
+#include "grasp/grasp_machine.hpp"
+#include "grasp/grasp_node.hpp"
+#include "grasp/grasp_settings.hpp"
 #include "stereograsp/arm_cmd_t.hpp"
 #include "stereograsp/arm_status_t.hpp"
 #include "stereograsp/grasp_command_t.hpp"
@@ -86,6 +86,8 @@ int main(int argc, char** argv) {
                           "aim at the last measured position instead of the predicted one");
   common.flags.add(app, "--standoff", "grasp.standoff", keys);
   common.flags.add(app, "--speed", "grasp.speed", keys);
+  common.flags.add(app, "--confidence", "grasp.confidence", keys);
+  common.flags.add(app, "--max-wait", "grasp.max_wait", keys);
   double status_rate = 4;
   app.add_option("--status-rate", status_rate, "GRASP_STATUS per second besides changes")
       ->check(CLI::Range(0.5, 100.0))

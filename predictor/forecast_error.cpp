@@ -3,29 +3,75 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 namespace sg::predictor {
 
 ForecastError::ForecastError(int horizon, int max_gap, const ForecastErrorParams& p)
     : horizon_(horizon), params_(p) {
-  if (horizon < 1 || max_gap < 0 || p.window < 1)
-    throw std::invalid_argument("forecast error: horizon and window must be positive");
+  if (horizon < 1 || max_gap < 0 || p.window < 1 || p.window > kMaxWindow)
+    throw std::invalid_argument(
+        "forecast error: horizon and window must be positive (window "
+        "at most " +
+        std::to_string(kMaxWindow) + ")");
   if (!(p.prior_sigma > 0) || !std::isfinite(p.prior_sigma) || !(p.min_sigma > 0) ||
       !std::isfinite(p.min_sigma))
     throw std::invalid_argument("forecast error: prior_sigma and min_sigma must be positive");
   const size_t n = static_cast<size_t>(horizon) + static_cast<size_t>(max_gap);
-  mean_square_.resize(n);
+  const size_t w = static_cast<size_t>(p.window);
+  window_.assign(n * w, Eigen::Vector3d::Zero());
+  noise_.assign(n * w, Eigen::Vector3d::Zero());
+  sum_.resize(n);
+  noise_sum_.assign(n, Eigen::Vector3d::Zero());
+  filled_.assign(n, 1);
+  head_.assign(n, 1 % p.window);
   scores_.assign(n, 0);
-  for (size_t b = 0; b < n; ++b) {
+  for (size_t b = 0; b < n; ++b) {  // the prior is each window's first entry
     const double s = p.prior_sigma * static_cast<double>(b + 1);
-    mean_square_[b] = Eigen::Vector3d::Constant(s * s);
+    window_[b * w] = sum_[b] = Eigen::Vector3d::Constant(s * s);
   }
   kept_.resize(static_cast<size_t>(horizon));
   for (Kept& k : kept_) k.positions.reserve(static_cast<size_t>(horizon));
 }
 
+double ForecastError::predictive_factor(double m) {
+  if (m < 2) return 2.0;  // the prior alone, or one score: no spread known
+  // Student's t quantile at 0.97725 (the normal's 2 sigma) for nu = m - 1 degrees of freedom,
+  // by the Cornish-Fisher expansion: the interval holds within 0.0005 of the normal's 0.97725
+  // from m = 8 on (0.9748 at m = 4; the prior and a few scores only at a start).
+  const double z = 2.0, nu = m - 1;
+  const double t = z + (z * z * z + z) / (4 * nu) +
+                   (5 * std::pow(z, 5) + 16 * z * z * z + 3 * z) / (96 * nu * nu);
+  return std::min(2.0, t / z * std::sqrt(1 + 1 / m));
+}
+
 size_t ForecastError::bucket(int samples) const {
   return static_cast<size_t>(std::clamp(samples, 1, horizons()) - 1);
+}
+
+void ForecastError::add(size_t b, const Eigen::Vector3d& value, const Eigen::Vector3d& noise) {
+  const size_t w = static_cast<size_t>(params_.window);
+  Eigen::Vector3d* ring = &window_[b * w];
+  Eigen::Vector3d* noise_ring = &noise_[b * w];
+  const size_t head = static_cast<size_t>(head_[b]);
+  if (filled_[b] == params_.window) {
+    sum_[b] -= ring[head];
+    noise_sum_[b] -= noise_ring[head];
+  }
+  ring[head] = value;
+  noise_ring[head] = noise;
+  sum_[b] += value;
+  noise_sum_[b] += noise;
+  filled_[b] = std::min(filled_[b] + 1, params_.window);
+  head_[b] = static_cast<int>((head + 1) % w);
+  if (head_[b] == 0) {  // once a round, the sum afresh: no rounding drift over a long session
+    sum_[b].setZero();
+    noise_sum_[b].setZero();
+    for (size_t i = 0; i < static_cast<size_t>(filled_[b]); ++i) {
+      sum_[b] += ring[i];
+      noise_sum_[b] += noise_ring[i];
+    }
+  }
 }
 
 void ForecastError::record(int64_t utime, int occluded, const std::vector<Eigen::Vector3d>& pos,
@@ -57,8 +103,7 @@ void ForecastError::score(int64_t utime, const Eigen::Vector3d& sample,
     const Eigen::Vector3d e = sample - k.positions[static_cast<size_t>(h - 1)];
     if (!(e.cwiseAbs().maxCoeff() <= 1e6)) continue;  // NaN too
     const size_t b = bucket(h + k.occluded);
-    const double lambda = std::max(1.0 / static_cast<double>(scores_[b] + 2), 1.0 / params_.window);
-    mean_square_[b] += lambda * (e.cwiseAbs2() - noise - mean_square_[b]);
+    add(b, e.cwiseAbs2(), noise);
     ++scores_[b];
   }
 }
@@ -70,7 +115,11 @@ void ForecastError::reset() {
 }
 
 Eigen::Vector3d ForecastError::sigma(int samples) const {
-  return mean_square_[bucket(samples)].cwiseMax(0).cwiseSqrt().cwiseMax(params_.min_sigma);
+  const size_t b = bucket(samples);
+  const double m = static_cast<double>(filled_[b]);
+  const Eigen::Vector3d square = (sum_[b] - noise_sum_[b]) / m;
+  const double widen = params_.predictive ? predictive_factor(m) : 1.0;
+  return widen * square.cwiseMax(0).cwiseSqrt().cwiseMax(params_.min_sigma);
 }
 
 int64_t ForecastError::scores(int samples) const { return scores_[bucket(samples)]; }

@@ -8,12 +8,19 @@
 /// kept forecast whose point h was for t is scored: its error e = x(t) - x_hat(t) goes to the
 /// estimate of horizon b = h + k, the samples since the last measurement that forecast rested on
 /// (a forecast made 3 samples into an occlusion forecasts its first point 4 samples past what it
-/// saw). Per horizon and axis the estimate is a mean square
+/// saw). Per horizon and axis the estimate is the mean square over a sliding window of the last
+/// `window` scores,
 ///
-///     s_b^2 <- s_b^2 + lambda (e^2 - r^2 - s_b^2),   lambda = max(1 / (n_b + 2), 1 / window)
+///     s_b^2 = (1 / m) sum over the last m scores of (e^2 - r^2),   m = min(n_b + 1, window)
 ///
-/// (n_b the scores before this one): a running mean over the prior s_b = prior_sigma * b, which
-/// counts as one score, and the first scores, then an exponential window of `window` scores.
+/// where the prior (prior_sigma * b)^2 is the first score, so it counts until `window` real
+/// ones have followed. A sliding window, not an exponential one: the start-up's errors (a model
+/// not yet fitted, 10-100 times the error it settles to) and a turn's are forgotten entirely
+/// `window` scores later (15 s at 4 Hz with the default 60), where an exponential average keeps a
+/// share of them for minutes. The share of true positions within 2 sigma on the paper's motion
+/// is then 91-95% (40 scores: 90-93%; 80, the paper's 20 s drift period: the estimate clears of
+/// one reversal just as the next comes; docs/prediction.md). sigma() is widened by
+/// predictive_factor() (Student's t for the m scores) unless params.predictive is false.
 /// r is the measured sample's own sigma (zero when not known): taken out, what is estimated is
 /// the forecast's error against where the ball is, which a grasp needs, not against a noisy
 /// measurement of it. sigma(b) is sqrt(max(s_b^2, 0)), at least min_sigma. The estimates survive
@@ -36,16 +43,22 @@ namespace sg::predictor {
 
 struct ForecastErrorParams {
   double prior_sigma = 0.005;  ///< m per axis and sample of horizon, before any score
-  int window = 200;            ///< scores the estimate averages once it has had that many
+  int window = 60;             ///< the last scores the estimate averages (the prior the first)
   double min_sigma = 1e-4;     ///< m: no horizon is ever surer than this
+  /// sigma() widened by predictive_factor(m): 2 sigma then bounds the next error as often as a
+  /// normal's 2 sigma does, although s is estimated from m scores (Student's t). false: s itself.
+  bool predictive = true;
 };
 
 class ForecastError {
  public:
+  /// The longest window: 10^4 scores (45 minutes at 4 Hz) a horizon.
+  static constexpr int kMaxWindow = 10'000;
+
   /// `horizon`: points per forecast (H >= 1); `max_gap`: fed-back samples a forecast may rest on
   /// (>= 0). Horizons 1 .. horizon + max_gap are estimated. Throws std::invalid_argument on a
-  /// horizon below 1, a negative max_gap, a window below 1 or a prior or floor not positive and
-  /// finite.
+  /// horizon below 1, a negative max_gap, a window outside 1..kMaxWindow or a prior or floor not
+  /// positive and finite.
   ForecastError(int horizon, int max_gap, const ForecastErrorParams& params = {});
 
   /// Keeps the forecast made at grid time `utime` (its point h for utime + h period_us) after
@@ -69,7 +82,10 @@ class ForecastError {
   Eigen::Vector3d sigma(int samples) const;
   /// Scores the estimate of that horizon has had (0 .. ; the prior not counted).
   int64_t scores(int samples) const;
-  int horizons() const { return static_cast<int>(mean_square_.size()); }
+  /// t_{m-1}(0.97725) sqrt(1 + 1/m) / 2, at most 2: how much wider than 2 s a 2-sigma interval
+  /// for the next error must be when s is estimated from m scores (1.05 at m = 40; 2 for m < 2).
+  static double predictive_factor(double m);
+  int horizons() const { return static_cast<int>(sum_.size()); }
 
  private:
   struct Kept {
@@ -80,10 +96,17 @@ class ForecastError {
     std::vector<Eigen::Vector3d> positions;  // capacity horizon, reserved once
   };
   size_t bucket(int samples) const;
+  /// Adds e^2 and r^2 to bucket b's window, dropping its oldest entry when it is full.
+  void add(size_t b, const Eigen::Vector3d& value, const Eigen::Vector3d& noise);
 
   int horizon_;
   ForecastErrorParams params_;
-  std::vector<Eigen::Vector3d> mean_square_;  // per horizon - 1
+  std::vector<Eigen::Vector3d> window_;     // per bucket `window` squared errors e^2, a ring each
+  std::vector<Eigen::Vector3d> noise_;      // the same rings: each score's sample variance r^2
+  std::vector<Eigen::Vector3d> sum_;        // per bucket: the sum of its e^2 ring
+  std::vector<Eigen::Vector3d> noise_sum_;  // per bucket: the sum of its r^2 ring
+  std::vector<int> filled_;                 // per bucket: entries in its ring (the prior the first)
+  std::vector<int> head_;                   // per bucket: where its next entry goes
   std::vector<int64_t> scores_;
   std::vector<Kept> kept_;  // a ring of the last `horizon` forecasts
   size_t next_ = 0;         // where the next forecast goes

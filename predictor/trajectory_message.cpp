@@ -19,6 +19,10 @@ trajectory_t to_trajectory_t(const Forecast& f, const PredictorParams& p) {
   t.period_us = f.period_us;
   t.num_points = static_cast<int32_t>(f.positions.size());
   for (const auto& q : f.positions) t.position.push_back({q.x(), q.y(), q.z()});
+  for (size_t i = 0; i < f.positions.size(); ++i) {
+    const Eigen::Vector3d s = i < f.sigma.size() ? f.sigma[i] : Eigen::Vector3d::Zero();
+    t.position_sigma.push_back({s.x(), s.y(), s.z()});
+  }
   t.occluded_samples = f.occluded_samples;
   t.status = f.status == TrackStatus::kOccluded ? trajectory_t::STATUS_OCCLUDED
              : f.status == TrackStatus::kLost   ? trajectory_t::STATUS_LOST

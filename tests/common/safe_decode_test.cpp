@@ -48,6 +48,7 @@ void fill_arrays(M&, std::mt19937_64&) {}
 void fill_arrays(trajectory_t& t, std::mt19937_64& rng) {
   t.num_points = static_cast<int32_t>(rng() % 20);
   t.position.assign(static_cast<size_t>(t.num_points), std::vector<double>{1.0, -2.0, 3.5});
+  t.position_sigma.assign(static_cast<size_t>(t.num_points), std::vector<double>{0.1, 0.2, 0.3});
 }
 void fill_arrays(image_t& m, std::mt19937_64& rng) {
   m.size = static_cast<int32_t>(rng() % 300);
@@ -181,6 +182,7 @@ TEST(SafeDecode, ArrayLongerThanThePacketIsRefused) {
   trajectory_t t{};
   t.num_points = 2;
   t.position.assign(2, std::vector<double>(3, 0.5));
+  t.position_sigma.assign(2, std::vector<double>(3, 0.01));
   std::vector<uint8_t> bytes = encode_message(t);
   put_int32(bytes, 8 + 4 * 8, 3);
   trajectory_t m{};

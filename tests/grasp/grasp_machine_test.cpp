@@ -111,6 +111,12 @@ struct Rig {
 
   /// A fresh trajectory (made at now, from a frame captured 50 ms before).
   void feed(double z = 0.10) { machine.on_trajectory(circle_path(now, z), now - 50'000, now); }
+  /// A fresh trajectory whose every point carries the 1-sigma error `sigma` per axis.
+  void feed_with_sigma(double sigma) {
+    PredictedPath path = circle_path(now);
+    path.sigmas.assign(path.points.size(), Eigen::Vector3d::Constant(sigma));
+    machine.on_trajectory(path, now - 50'000, now);
+  }
   void lose() {
     PredictedPath path = circle_path(now);
     path.lost = true;
@@ -568,6 +574,72 @@ TEST(GraspMachineTest, FarApproachClosesInFirst) {
   const std::optional<ArmRequest> approach = rig.take();
   ASSERT_EQ(kind(approach), Req::kApproach) << rig.status().message;
   EXPECT_EQ(rig.status().state, GraspState::kGrasping);
+}
+
+// A forecast too unsure for the gripper (2 sigma of 0.02 m per axis is 69 mm > 20 mm) keeps the
+// arm tracking above the ball in q1 and says so; a sure one (0.002 m per axis: 2 x sqrt(12e-6 +
+// arm 1e-6 + (15.7 mm/s x 0.035 s)^2) = 7.3 mm) sends the approach with the CLOSE.
+TEST(GraspMachineTest, WaitsToCloseUntilTheForecastIsSure) {
+  Rig rig;
+  reach(rig, At::kQ0Tracking);
+  rig.run();
+  rig.advance(0.8);
+  rig.feed_with_sigma(0.02);
+  rig.command(GraspCommand::kGrasp);
+  const std::optional<ArmRequest> wait = rig.take();
+  ASSERT_EQ(kind(wait), Req::kMove) << rig.status().message;
+  EXPECT_NEAR(wait->position.z(), 0.10 + rig.settings.standoff, 0.002);
+  EXPECT_EQ(rig.status().state, GraspState::kApproaching);
+  EXPECT_EQ(rig.status().message.rfind("waiting to close: 2.0 sigma 69.", 0), 0u)
+      << rig.status().message;
+  EXPECT_NE(rig.status().message.find("> 20.0 mm tolerance (8.0 s left)"), std::string::npos)
+      << rig.status().message;
+  rig.advance(0.8);
+  rig.executed(*wait);
+  rig.feed_with_sigma(0.002);
+  const std::optional<ArmRequest> approach = rig.take();
+  ASSERT_EQ(kind(approach), Req::kApproach) << rig.status().message;
+  EXPECT_EQ(rig.status().state, GraspState::kGrasping);
+  EXPECT_EQ(rig.status().message, "closing: 2.0 sigma 7.3 mm <= 20.0 mm tolerance");
+}
+
+// A forecast that never becomes sure: the machine tracks until max_wait after the grasp command,
+// then closes on its best guess and says so (the operator's grasp is carried out, late).
+TEST(GraspMachineTest, ClosesOnAGuessAfterMaxWait) {
+  GraspSettings s;
+  s.max_wait = 3.0;
+  Rig rig(s);
+  reach(rig, At::kQ0Tracking);
+  rig.run();
+  rig.advance(0.8);
+  rig.feed_with_sigma(0.05);
+  rig.command(GraspCommand::kGrasp);
+  for (int i = 0; i < 3; ++i) {  // at 0, 0.8 and 1.6 s
+    const std::optional<ArmRequest> wait = rig.take();
+    ASSERT_EQ(kind(wait), Req::kMove) << i << ": " << rig.status().message;
+    rig.advance(0.8);
+    rig.executed(*wait);
+    rig.feed_with_sigma(0.05);
+  }
+  rig.advance(0.8);  // 3.2 s after the command
+  rig.feed_with_sigma(0.05);
+  const std::optional<ArmRequest> guess = rig.take();
+  ASSERT_EQ(kind(guess), Req::kApproach) << rig.status().message;
+  EXPECT_EQ(rig.status().message.rfind("closing on a guess after 3.0 s: 2.0 sigma ", 0), 0u)
+      << rig.status().message;
+}
+
+// A confidence of 0 closes at once, however unsure the forecast (the machine before issue 17).
+TEST(GraspMachineTest, ConfidenceZeroClosesAtOnce) {
+  GraspSettings s;
+  s.confidence = 0;
+  Rig rig(s);
+  reach(rig, At::kQ0Tracking);
+  rig.run();
+  rig.advance(0.8);
+  rig.feed_with_sigma(0.05);
+  rig.command(GraspCommand::kGrasp);
+  EXPECT_EQ(kind(rig.take()), Req::kApproach) << rig.status().message;
 }
 
 // After the lift, the ball measured far from the tool for judge_time means the grasp failed; the

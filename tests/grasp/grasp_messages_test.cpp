@@ -21,6 +21,7 @@ trajectory_t three_points() {
   m.period_us = 250'000;
   m.num_points = 3;
   m.position = {{0.1, 0.2, 0.3}, {0.4, 0.5, 0.6}, {0.7, 0.8, 0.9}};
+  m.position_sigma = {{0.001, 0.002, 0.003}, {0.004, 0.005, 0.006}, {0.007, 0.008, 0.009}};
   m.status = trajectory_t::STATUS_TRACKING;
   return m;
 }
@@ -133,6 +134,8 @@ TEST(GraspMessages, TrajectoryToPath) {
   EXPECT_EQ(p->period_us, 250'000);
   ASSERT_EQ(p->points.size(), 3u);
   EXPECT_EQ(p->points[2].y(), 0.8);
+  ASSERT_EQ(p->sigmas.size(), 3u);
+  EXPECT_EQ(p->sigmas[1], Eigen::Vector3d(0.004, 0.005, 0.006));
   EXPECT_FALSE(p->lost);
 }
 
@@ -153,6 +156,18 @@ TEST(GraspMessages, MalformedTrajectoriesAreRefused) {
   EXPECT_EQ(why, "point 1 is not 3 finite numbers");
   m.position[1] = {0.1, 0.2};
   EXPECT_FALSE(path_from(m, &why));
+  m = three_points();
+  m.position_sigma.pop_back();
+  EXPECT_FALSE(path_from(m, &why));
+  EXPECT_EQ(why, "2 sigmas for 3 points");
+  for (const double bad : {-0.001, std::nan(""), HUGE_VAL}) {
+    m = three_points();
+    m.position_sigma[2][0] = bad;
+    EXPECT_FALSE(path_from(m, &why)) << bad;
+    EXPECT_EQ(why, "sigma 2 is not 3 finite numbers >= 0") << bad;
+  }
+  m = three_points();
+  m.position[1] = {0.1, 0.2};
   m.status = trajectory_t::STATUS_LOST;
   const auto lost = path_from(m, &why);
   ASSERT_TRUE(lost);

@@ -50,6 +50,7 @@ struct Rig {
     m.start_utime = now + m.period_us;
     m.num_points = 16;
     m.position.assign(16, std::vector<double>{0.45, 0.0, 0.10});
+    m.position_sigma.assign(16, std::vector<double>{0.001, 0.001, 0.001});
     m.status = trajectory_t::STATUS_TRACKING;
     return m;
   }

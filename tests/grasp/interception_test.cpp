@@ -15,11 +15,11 @@
 namespace sg::grasp {
 namespace {
 
+using arm::forward_kinematics;
 using arm::IkResult;
+using arm::motion_time;
 using arm::pose_from_xyz_rpy;
 using arm::solve_nearest;
-using arm::forward_kinematics;
-using arm::motion_time;
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kDeg = kPi / 180.0;
@@ -125,6 +125,23 @@ TEST(PredictedPathTest, NothingOutsideTheHorizonOrWhenLost) {
   empty.start_utime = 250'000;
   EXPECT_EQ(empty.end_utime(), 250'000);
   EXPECT_FALSE(empty.at(250'000));
+}
+
+// The sigmas interpolate like the points, but stay at sigmas[0] before start_utime (an error does
+// not shrink toward zero by extrapolation); no sigmas or a lost path give none.
+TEST(PredictedPathTest, SigmaInterpolatesAndHoldsBeforeTheFirstPoint) {
+  PredictedPath path = three_points();
+  EXPECT_FALSE(path.sigma_at(1'375'000));  // none carried
+  path.sigmas = {{0.001, 0.002, 0.003}, {0.003, 0.004, 0.005}, {0.007, 0.008, 0.009}};
+  ASSERT_TRUE(path.sigma_at(1'375'000));
+  EXPECT_TRUE(path.sigma_at(1'375'000)->isApprox(Eigen::Vector3d(0.002, 0.003, 0.004), 1e-14));
+  ASSERT_TRUE(path.sigma_at(1'750'000));
+  EXPECT_EQ(*path.sigma_at(1'750'000), path.sigmas[2]);
+  ASSERT_TRUE(path.sigma_at(1'000'000));
+  EXPECT_EQ(*path.sigma_at(1'000'000), path.sigmas[0]);
+  EXPECT_FALSE(path.sigma_at(1'750'001));
+  path.sigmas.pop_back();  // not one per point: none
+  EXPECT_FALSE(path.sigma_at(1'375'000));
 }
 
 // hold() stays at the position from utime to utime + count periods.

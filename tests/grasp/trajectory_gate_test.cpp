@@ -33,14 +33,14 @@ trajectory_t good(int64_t now) {
   m.start_utime = now + m.period_us;
   m.num_points = 16;
   m.position.assign(16, std::vector<double>{0.45, 0.0, 0.10});
+  m.position_sigma.assign(16, std::vector<double>{0.001, 0.001, 0.001});
   m.status = trajectory_t::STATUS_TRACKING;
   return m;
 }
 
 /// The reason check_trajectory() gives `m` at kT0 with the A465's workspace and the defaults.
 std::optional<TrajectoryRefusal> refusal(const trajectory_t& m, int64_t now = kT0) {
-  const TrajectoryCheck c =
-      check_trajectory(m, ArmGeometry::a465().workspace, InputGate{}, now);
+  const TrajectoryCheck c = check_trajectory(m, ArmGeometry::a465().workspace, InputGate{}, now);
   if (c.path) return std::nullopt;
   EXPECT_FALSE(c.why.empty());
   return c.reason;
@@ -57,7 +57,9 @@ trajectory_t bad(Change change) {
 // A well-formed trajectory on the ball passes; a point inside the 0.25 m margin passes.
 TEST(CheckTrajectory, AcceptsAPlausibleTrajectory) {
   EXPECT_EQ(refusal(good(kT0)), std::nullopt);
-  EXPECT_EQ(refusal(bad([](trajectory_t& m) { m.position[3] = {1.14, -1.14, -0.19}; })),
+  EXPECT_EQ(refusal(bad([](trajectory_t& m) {
+              m.position[3] = {1.14, -1.14, -0.19};
+            })),
             std::nullopt);
   EXPECT_EQ(refusal(good(kT0 - 4 * kSecond)), std::nullopt);  // 4 s old: within 5 s
 }
@@ -68,9 +70,13 @@ TEST(CheckTrajectory, RefusesEachImplausibleField) {
   const double nan = std::nan(""), inf = std::numeric_limits<double>::infinity();
   EXPECT_EQ(refusal(bad([&](trajectory_t& m) { m.position[5][1] = nan; })), R::kNonFinite);
   EXPECT_EQ(refusal(bad([&](trajectory_t& m) { m.position[0][2] = -inf; })), R::kNonFinite);
-  EXPECT_EQ(refusal(bad([](trajectory_t& m) { m.position[15] = {1e300, 1e300, 1e300}; })),
+  EXPECT_EQ(refusal(bad([](trajectory_t& m) {
+              m.position[15] = {1e300, 1e300, 1e300};
+            })),
             R::kOutsideWorkspace);
-  EXPECT_EQ(refusal(bad([](trajectory_t& m) { m.position[2] = {0.45, 0, -0.5}; })),
+  EXPECT_EQ(refusal(bad([](trajectory_t& m) {
+              m.position[2] = {0.45, 0, -0.5};
+            })),
             R::kOutsideWorkspace);
   EXPECT_EQ(refusal(bad([](trajectory_t& m) { m.period_us = 0; })), R::kBadPeriod);
   EXPECT_EQ(refusal(bad([](trajectory_t& m) { m.period_us = -250'000; })), R::kBadPeriod);
@@ -78,6 +84,7 @@ TEST(CheckTrajectory, RefusesEachImplausibleField) {
   EXPECT_EQ(refusal(bad([](trajectory_t& m) {
               m.num_points = kMaxTrajectoryPoints + 1;
               m.position.assign(static_cast<size_t>(m.num_points), {0.45, 0, 0.1});
+              m.position_sigma.assign(static_cast<size_t>(m.num_points), {0.001, 0.001, 0.001});
             })),
             R::kTooManyPoints);
   EXPECT_EQ(refusal(bad([](trajectory_t& m) { m.num_points = 17; })), R::kMalformed);
@@ -95,6 +102,7 @@ TEST(CheckTrajectory, ALostTrackIsCheckedForTimesOnly) {
   trajectory_t lost = good(kT0);
   lost.status = trajectory_t::STATUS_LOST;
   lost.position.assign(16, std::vector<double>{std::nan(""), 0, 0});
+  lost.position_sigma.assign(16, std::vector<double>{0.001, 0.001, 0.001});
   EXPECT_EQ(refusal(lost), std::nullopt);
   lost.start_utime = kT0 + 3600 * kSecond;
   EXPECT_EQ(refusal(lost), TrajectoryRefusal::kTimeFarFromNow);

@@ -21,7 +21,6 @@ namespace {
 using namespace std::chrono_literals;
 using Cmd = stereograsp::arm_cmd_t;
 
-
 /// The joints of an "MA j1,...,j6" line (degrees in the line, radians out); nullopt otherwise.
 std::optional<arm::Joints> ma_joints(const std::string& command) {
   if (command.rfind("MA ", 0) != 0) return std::nullopt;
@@ -60,13 +59,14 @@ LoopObserver::LoopObserver(Bus& bus) {
   bus.subscribe<stereograsp::arm_status_t>("ARM_STATUS", [this](const auto& m, const auto&) {
     arm_ = m;
     ++arm_statuses_;
-    if (m.last_executed_sequence >= 0) executed_[m.last_executed_sequence][m.driver_start_utime] = 1;
+    if (m.last_executed_sequence >= 0)
+      executed_[m.last_executed_sequence][m.driver_start_utime] = 1;
   });
   bus.subscribe<Cmd>("ARM_COMMAND", [this](const Cmd& m, const ReceiveInfo& info) {
     commands_.push_back({info.recv_utime, m.sender, m.mode, m.sequence});
   });
-  bus.subscribe<stereograsp::grasp_status_t>(
-      "GRASP_STATUS", [this](const auto& m, const auto&) { grasp_ = m; });
+  bus.subscribe<stereograsp::grasp_status_t>("GRASP_STATUS",
+                                             [this](const auto& m, const auto&) { grasp_ = m; });
   bus.subscribe<stereograsp::trajectory_t>("OBJECT_TRAJECTORY",
                                            [this](const auto& m, const auto&) { forecast_ = m; });
   bus.subscribe<stereograsp::point3_t>("GROUND_TRUTH",
@@ -180,29 +180,37 @@ FaultLoop::~FaultLoop() {
 std::vector<std::string> FaultLoop::argv(const std::string& name) const {
   const std::string quiet = "--log-level=warn";
   if (name == "c550") {
-    std::vector<std::string> a = {program("sg-c550-sim"), "--lcm-url", url_, "--link",
-                                  dir_ + "/c550", "--log-commands", command_log(), quiet};
+    std::vector<std::string> a = {program("sg-c550-sim"), "--lcm-url",      url_,          "--link",
+                                  dir_ + "/c550",         "--log-commands", command_log(), quiet};
     a.insert(a.end(), options_.c550_args.begin(), options_.c550_args.end());
     return a;
   }
   if (name == "driver") {
     const char* level = std::getenv("SG_FAULT_DRIVER_LOG_LEVEL");  // e.g. debug, to see why
-    return {program("sg-arm-driver"), "--lcm-url", url_, "--device", dir_ + "/c550",
+    return {program("sg-arm-driver"),
+            "--lcm-url",
+            url_,
+            "--device",
+            dir_ + "/c550",
             std::string("--log-level=") + (level ? level : "info")};
   }
   if (name == "vision")
     return {program("sg-vision"), "--lcm-url", url_, "--calibration", files_.calibration, quiet};
   if (name == "predictor")
-    return {program("sg-predictor"), "--lcm-url", url_, "--coefficients", files_.coefficients,
-            quiet};
+    return {program("sg-predictor"), "--lcm-url",         url_,
+            "--coefficients",        files_.coefficients, quiet};
   if (name == "grasp" || name == "grasp2") {
     std::vector<std::string> a = options_.grasp_prefix;
-    for (const std::string& s : {program("sg-grasp"), std::string("--lcm-url"), url_})
+    // A session of seconds: the forecasts stay unsure for 20-30 s, and sg-grasp waits until they
+    // are sure before it closes (docs/grasping.md), here up to 30 s.
+    for (const std::string& s : {program("sg-grasp"), std::string("--lcm-url"), url_,
+                                 std::string("--max-wait"), std::string("30")})
       a.push_back(s);
     a.insert(a.end(), options_.grasp_args.begin(), options_.grasp_args.end());
     return a;
   }
-  if (name == "cameras") return {program("sg-camera-sim"), "--lcm-url", url_, "--rate", "10", quiet};
+  if (name == "cameras")
+    return {program("sg-camera-sim"), "--lcm-url", url_, "--rate", "10", quiet};
   throw std::invalid_argument("no process " + name);
 }
 
@@ -250,7 +258,8 @@ int64_t FaultLoop::kill(const std::string& name) {
 ProcessResult FaultLoop::run_watching(const std::vector<std::string>& argv,
                                       std::chrono::milliseconds timeout) {
   Child child(argv);
-  wait_until(*bus_, [&] { return !child.running(); }, timeout);
+  wait_until(
+      *bus_, [&] { return !child.running(); }, timeout);
   return child.wait(1s);
 }
 

@@ -125,6 +125,7 @@ TEST(ChannelCsv, SeveralTypesExactFiles) {
     trajectory.period_us = 250000;
     trajectory.num_points = 2;
     trajectory.position = {{1, 2, 3}, {4.5, -5, 6}};
+    trajectory.position_sigma = {{0.5, 0.25, 0.125}, {1, 2, 4}};
     trajectory.status = stereograsp::trajectory_t::STATUS_TRACKING;
     trajectory.model = stereograsp::trajectory_t::MODEL_BURG;
     trajectory.model_order = 8;
@@ -161,13 +162,14 @@ TEST(ChannelCsv, SeveralTypesExactFiles) {
   for (int i = 0; i < 32; ++i) auth_names += ",auth_tag_" + std::to_string(i), auth_zeros += ",0";
   EXPECT_EQ(test::read_text(dir + "/GRASP_COMMAND.csv"),
             "recv_utime,utime,sequence,command,standoff,sender" + auth_names + "\n" +
-                "100,5,7,2,0.125,\"op, \"\"bob\"\"\"" + auth_zeros + "\n" +
-                "103,5,8,2,0.125,\"\"" + auth_zeros + "\n");
+                "100,5,7,2,0.125,\"op, \"\"bob\"\"\"" + auth_zeros + "\n" + "103,5,8,2,0.125,\"\"" +
+                auth_zeros + "\n");
   EXPECT_EQ(test::read_text(dir + "/OBJECT_TRAJECTORY.csv"),
             "recv_utime,utime,source_utime,start_utime,period_us,num_points,position_0_0,"
-            "position_0_1,position_0_2,position_1_0,position_1_1,position_1_2,occluded_samples,"
-            "status,model,model_order\n"
-            "101,10,9,11,250000,2,1,2,3,4.5,-5,6,0,1,1,8\n");
+            "position_0_1,position_0_2,position_1_0,position_1_1,position_1_2,position_sigma_0_0,"
+            "position_sigma_0_1,position_sigma_0_2,position_sigma_1_0,position_sigma_1_1,"
+            "position_sigma_1_2,occluded_samples,status,model,model_order\n"
+            "101,10,9,11,250000,2,1,2,3,4.5,-5,6,0.5,0.25,0.125,1,2,4,0,1,1,8\n");
   EXPECT_EQ(test::read_text(dir + "/CAMERA_RIGHT.csv"),
             "recv_utime,utime,camera,frame_number,width,height,row_stride,pixel_format,size\n"
             "102,20,1,3,2,1,2,1,2\n");
@@ -346,6 +348,7 @@ TEST(CsvWriter, TrajectoryLengthChangesKeepTheHeader) {
     t.utime = n;
     t.num_points = n;
     t.position.assign(n, std::vector<double>{1.5, 2.5, 3.5});
+    t.position_sigma.assign(n, std::vector<double>{0.5, 0.25, 0.125});
     const std::vector<uint8_t> bytes = encode_message(t);
     ASSERT_TRUE(writer.write(out, n, bytes.data(), static_cast<int>(bytes.size())));
   }
@@ -353,10 +356,11 @@ TEST(CsvWriter, TrajectoryLengthChangesKeepTheHeader) {
   EXPECT_EQ(writer.misaligned_rows(), 2);
   const auto rows = parse_csv(out.str());
   ASSERT_EQ(rows.size(), 4u);
-  for (const auto& row : rows) EXPECT_EQ(row.size(), 16u);
-  EXPECT_EQ(rows[2][5], "3");     // num_points tells the truth
-  EXPECT_EQ(rows[2][11], "3.5");  // position_1_2
-  EXPECT_EQ(rows[3][9], "");      // position_1_0 of the one-point trajectory
+  for (const auto& row : rows) EXPECT_EQ(row.size(), 22u);  // 2 points and 2 sigmas of 3
+  EXPECT_EQ(rows[2][17], "0.125");                          // position_sigma_1_2
+  EXPECT_EQ(rows[2][5], "3");                               // num_points tells the truth
+  EXPECT_EQ(rows[2][11], "3.5");                            // position_1_2
+  EXPECT_EQ(rows[3][9], "");  // position_1_0 of the one-point trajectory
   EXPECT_EQ(rows[3][6], "1.5");
 }
 

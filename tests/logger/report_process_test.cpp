@@ -76,6 +76,7 @@ std::string synthetic_log(const std::string& dir) {
       t.start_utime = t.utime + t.period_us;
       t.num_points = 16;
       t.position.assign(16, std::vector<double>{0.5, 0, 0.2});
+      t.position_sigma.assign(16, std::vector<double>{0.001, 0.001, 0.001});
       t.status = 1;
       write_event(log, "OBJECT_TRAJECTORY", u + 8000, encode_message(t));
       ++trajectory;
@@ -233,8 +234,10 @@ TEST(ReportLive, RecordedSessionFromTheRealPredictor) {
   Child predictor({program("sg-predictor"), "--lcm-url", test_url(7922)});
   Child logger({SG_LCM_LOGGER, "--lcm-url=" + test_url(7922), log});
   ASSERT_TRUE(eventually(
-      [&] { return joined_bus(predictor.pid(), 7922) && joined_bus(logger.pid(), 7922); }, 30s,
-      "sg-predictor and lcm-logger to join the bus"));
+      [&] {
+        return listening_on_bus(predictor.pid(), 7922) && listening_on_bus(logger.pid(), 7922);
+      },
+      30s, "sg-predictor and lcm-logger to join the bus"));
 
   Bus bus(test_url(7922));
   int64_t newest_source = 0;  // the newest forecast's measurement time

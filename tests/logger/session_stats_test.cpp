@@ -102,6 +102,7 @@ std::string make_log() {
     for (int i = 0; i < 16; ++i) {
       const Vec3 x = circle(t.start_utime + i * t.period_us) + Vec3(0, 0, kOffset);
       t.position.push_back({x[0], x[1], x[2]});
+      t.position_sigma.push_back({0.001, 0.001, 0.001});
     }
     const bool in_occlusion = t.utime >= kT0 + 10'000'000 && t.utime < kT0 + 11'500'000;
     t.status = in_occlusion ? stereograsp::trajectory_t::STATUS_OCCLUDED

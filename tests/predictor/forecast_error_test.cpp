@@ -38,7 +38,7 @@ void run(ForecastError& model, int n, int occluded, Error error) {
 // Every forecast off by (10, -20, 0) mm: after 2,000 scores a horizon's sigma is 10 and 20 mm,
 // the prior gone, and z at the floor.
 TEST(ForecastError, ConstantErrorIsItsSigma) {
-  ForecastError model(kH, 4);
+  ForecastError model(kH, 4, {.predictive = false});
   EXPECT_NEAR(model.sigma(4).x(), 0.020, 1e-12) << "the prior: 5 mm a sample";
   run(model, 2000, 0, [](int, int) { return Eigen::Vector3d(0.010, -0.020, 0); });
   for (int h : {1, 4, 16}) {
@@ -79,7 +79,7 @@ TEST(ForecastError, TheSamplesOwnNoiseIsTakenOut) {
   std::mt19937 rng(5);
   std::normal_distribution<double> unit(0, 1);
   for (const bool told : {true, false}) {
-    ForecastError model(kH, 0);
+    ForecastError model(kH, 0, {.window = 200});
     std::vector<Eigen::Vector3d> f(kH);
     for (int k = 0; k < 3000; ++k) {
       const int64_t t = kT0 + k * kPeriod;
@@ -99,10 +99,63 @@ TEST(ForecastError, TheSamplesOwnNoiseIsTakenOut) {
   }
 }
 
+// A sliding window: a start-up's 100 mm errors are forgotten entirely once `window` (40) scores
+// of 2 mm have followed (an exponential average of 40 would still hold e^-1 of them); before
+// that, the mean square over the prior and the scores so far.
+TEST(ForecastError, TheWindowForgetsTheStartUpEntirely) {
+  ForecastError model(kH, 0, {.window = 40, .predictive = false});
+  EXPECT_NEAR(model.sigma(1).x(), 0.005, 1e-12) << "the prior alone";
+  run(model, 11, 0, [](int, int) { return Eigen::Vector3d(0.100, 0, 0); });
+  // 10 scores of 100 mm at h = 1 (the first sample scores nothing), with the 5 mm prior.
+  EXPECT_NEAR(model.sigma(1).x(), std::sqrt((0.005 * 0.005 + 10 * 0.01) / 11), 1e-12);
+  std::vector<Eigen::Vector3d> f(kH);
+  for (int k = 11; k < 11 + 40; ++k) {  // 40 scores of 2 mm at h = 1
+    const int64_t t = kT0 + k * kPeriod;
+    model.score(t, truth(k));
+    for (int h = 1; h <= kH; ++h)
+      f[static_cast<size_t>(h - 1)] = truth(k + h) + Eigen::Vector3d(0.002, 0, 0);
+    model.record(t, 0, f, kPeriod);
+  }
+  // The window: the last start-up forecast's score (at k = 11) and 39 of 2 mm.
+  EXPECT_NEAR(model.sigma(1).x(), std::sqrt((0.01 + 39 * 4e-6) / 40), 1e-12);
+  model.score(kT0 + 51 * kPeriod, truth(51));
+  EXPECT_NEAR(model.sigma(1).x(), 0.002, 1e-12) << "40 scores of 2 mm: the start-up gone";
+  EXPECT_THROW(ForecastError(kH, 0, {.window = ForecastError::kMaxWindow + 1}),
+               std::invalid_argument);
+}
+
+/// Student's t CDF with nu degrees of freedom at x > 0: Simpson's rule over its density.
+double student_cdf(double x, double nu) {
+  const double c = std::exp(std::lgamma((nu + 1) / 2) - std::lgamma(nu / 2)) / std::sqrt(nu * M_PI);
+  auto pdf = [&](double u) { return c * std::pow(1 + u * u / nu, -(nu + 1) / 2); };
+  const int n = 20000;
+  const double h = x / n;
+  double sum = pdf(0) + pdf(x);
+  for (int i = 1; i < n; ++i) sum += pdf(i * h) * (i % 2 ? 4 : 2);
+  return 0.5 + sum * h / 3;
+}
+
+// The widening: t_{m-1}(0.97725) sqrt(1 + 1/m) / 2, checked against the t distribution's CDF by
+// numerical integration (the normal's 2 sigma, 0.97725, at the widened 2 sigma), and 1.05 at m =
+// 40; the sigma reported is the plain one times it.
+TEST(ForecastError, PredictiveWideningIsStudentsT) {
+  for (const double m : {8.0, 10.0, 40.0, 60.0, 400.0}) {  // m = 4: 0.9748, the expansion's error
+    const double t = 2 * ForecastError::predictive_factor(m) / std::sqrt(1 + 1 / m);
+    EXPECT_NEAR(student_cdf(t, m - 1), 0.977250, 0.0005) << m;
+  }
+  EXPECT_NEAR(ForecastError::predictive_factor(40), 1.05, 0.005);
+  EXPECT_EQ(ForecastError::predictive_factor(1), 2.0);
+  ForecastError plain(kH, 0, {.predictive = false}), widened(kH, 0);
+  for (ForecastError* m : {&plain, &widened})
+    run(*m, 30, 0, [](int k, int) { return Eigen::Vector3d(0.001 * (k % 3), 0, 0); });
+  EXPECT_NEAR(widened.sigma(1).x(), plain.sigma(1).x() * ForecastError::predictive_factor(30),
+              1e-15);
+}
+
 // A forecast made 3 samples into an occlusion forecasts its point h for h + 3 samples past the
 // last measurement: that is the horizon its error counts at.
 TEST(ForecastError, OccludedForecastsCountAtTheirDistanceFromAMeasurement) {
-  ForecastError model(kH, 16);
+  ForecastError model(kH, 16, {.predictive = false});
   run(model, 2000, 3, [](int, int h) { return Eigen::Vector3d(0.001 * (h + 3), 0, 0); });
   EXPECT_EQ(model.scores(1), 0);
   EXPECT_EQ(model.scores(3), 0);

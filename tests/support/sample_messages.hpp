@@ -87,6 +87,8 @@ inline void make_consistent(stereograsp::image_t& m) {
 }
 inline void make_consistent(stereograsp::trajectory_t& m) {
   m.num_points = static_cast<int32_t>(m.position.size());
+  m.position_sigma.resize(m.position.size(), std::vector<double>(3, 0.0));
+  for (auto& s : m.position_sigma) s.resize(3, 0.0);
 }
 inline void make_consistent(stereograsp::blob_t& m) { m.found = m.found != 0; }
 inline void make_consistent(stereograsp::point3_t& m) { m.visible = m.visible != 0; }
