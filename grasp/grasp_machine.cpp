@@ -445,8 +445,9 @@ std::optional<ArmRequest> GraspMachine::send_approach(int64_t now) {
 std::optional<ArmRequest> GraspMachine::aim(Kind kind, int64_t now) {
   int64_t source_utime = 0;
   const std::optional<PredictedPath> path = fresh_path(now, &source_utime);
-  if (!path) {
-    refuse(kind == Kind::kTrack ? kStaleTrack : "no fresh track of the object");
+  if (!path) {  // an approach's waiting message is update()'s
+    if (kind != Kind::kApproach)
+      refuse(kind == Kind::kTrack ? kStaleTrack : "no fresh track of the object");
     return std::nullopt;
   }
   bool approach = kind == Kind::kApproach;
@@ -670,6 +671,14 @@ void GraspMachine::update(int64_t now) {
   note_stale_track(now);
   if (status_.state == GraspState::kApproaching && status_.activity == GraspActivity::kGrasping &&
       !track_fresh(now)) {
+    // Waiting to close (a panel or the gripper hides the ball longer than the predictor coasts):
+    // the arm holds where it is until the track returns, up to max_wait after the command.
+    const double left = settings_.max_wait - 1e-6 * static_cast<double>(now - grasp_utime_);
+    if (left > 0) {
+      refuse("waiting to close: no fresh track of the object (" + fixed(left, 1) + " s left)");
+      judge(now);
+      return;
+    }
     status_.state = GraspState::kHandOpened;
     status_.activity = GraspActivity::kBackingOff;
     status_.outcome = GraspOutcome::kFailed;

@@ -115,12 +115,15 @@
 ///    for a while, and vision then finds other red things.) Activity idle. (A measurement
 ///    from before the lift says nothing: the ball sits at the tool whether it was grasped or
 ///    not.)
-///  - Lost track in q1 (the trajectory is lost, or none newer than max_trajectory_age): the
-///    approach stops; state q0, activity backing off, outcome failed "track lost", and a move
-///    straight up by `backoff` from the current tool (orientation by forward kinematics of the
-///    current joints); idle when it is executed. In q2 and later the close is already on its way
-///    and the track is no longer needed. While tracking, a lost track only stops the requests
-///    (and the heartbeats) until it returns.
+///  - Lost track in q1 (the trajectory is lost, or none newer than max_trajectory_age): until
+///    max_wait after the grasp command the machine waits for it to return (no request; the arm
+///    holds; "waiting to close: no fresh track of the object (3.1 s left)"), as a panel or the
+///    gripper can hide the ball longer than the predictor coasts. Then the approach stops; state
+///    q0, activity backing off, outcome failed "track lost", and a move straight up by `backoff`
+///    from the current tool (orientation by forward kinematics of the current joints); idle when it
+///    is executed. In q2 and later the close is already on its way and the track is no longer
+///    needed. While tracking, a lost track only stops the requests (and the heartbeats) until it
+///    returns.
 ///  - A lift or back-off rejected by the arm ends the sequence (q3/idle failed, or q0/idle): the
 ///    same target would be rejected again. A rejected tracking move, approach, open or stop is
 ///    computed afresh and sent again (after the back-off).

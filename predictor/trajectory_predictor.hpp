@@ -25,7 +25,7 @@ struct PredictorParams {
   Model model = Model::kBurg;
   int64_t period_us = 250'000;  ///< the predictor's sample period (4 Hz)
   int horizon = 16;             ///< H: samples forecast (16 = 4 s)
-  int max_gap = 16;             ///< fed-back samples before the track is lost
+  int max_gap = 24;             ///< fed-back samples before the track is lost
   BurgParams burg;              ///< per axis; initial_coefficients below override it
   std::array<std::vector<double>, 3> initial_coefficients;  ///< offline-trained a_1..a_p per axis
   KalmanParams kalman;                                      ///< its period is set from period_us

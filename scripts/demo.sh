@@ -30,7 +30,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-track_seconds=${DEMO_TRACK_SECONDS:-15}
+track_seconds=${DEMO_TRACK_SECONDS:-60}  # a revolution at 1 rpm, and the forecasts sure by then
 tag=demo
 true_calibration=0
 with_images=0

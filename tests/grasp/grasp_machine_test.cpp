@@ -230,7 +230,9 @@ void reach(Rig& rig, At at) {
   rig.command(GraspCommand::kGrasp);
   ASSERT_EQ(rig.status().state, GraspState::kApproaching) << rig.status().message;
   if (at == At::kQ1) return;
-  if (at == At::kQ0BackingOff) {
+  if (at == At::kQ0BackingOff) {  // lost, and not back by max_wait after the command
+    rig.advance(rig.settings.max_wait);
+    rig.publish();
     rig.lose();
     return;
   }
@@ -723,7 +725,9 @@ TEST(GraspMachineTest, AbortFromEveryStateStopsAndOpens) {
 // A trajectory marked lost during the approach: the tool backs off straight up by `backoff`
 // from where it is, with the same orientation, and the grasp ends in q0 with outcome failed.
 TEST(GraspMachineTest, LostTrackDuringApproachBacksOff) {
-  Rig rig;
+  GraspSettings s;
+  s.max_wait = 0;  // no wait for the track to return
+  Rig rig(s);
   reach(rig, At::kQ0Tracking);
   const ArmRequest tracked = rig.run();
   rig.advance(0.8);
@@ -749,13 +753,54 @@ TEST(GraspMachineTest, LostTrackDuringApproachBacksOff) {
   EXPECT_FALSE(rig.take().has_value());
 }
 
+// A track lost while waiting to close (the ball hidden longer than the predictor coasts): the arm
+// holds (no request) and the machine waits; a fresh, sure track within max_wait sends the
+// approach; one still lost at max_wait backs off, failed.
+TEST(GraspMachineTest, LostTrackWhileWaitingWaitsUpToMaxWait) {
+  GraspSettings s;
+  s.max_wait = 3.0;
+  for (const bool returns : {true, false}) {
+    Rig rig(s);
+    reach(rig, At::kQ0Tracking);
+    rig.run();
+    rig.advance(0.8);
+    rig.feed_with_sigma(0.05);
+    rig.command(GraspCommand::kGrasp);
+    const std::optional<ArmRequest> wait = rig.take();
+    ASSERT_EQ(kind(wait), Req::kMove) << rig.status().message;
+    rig.advance(0.8);
+    rig.executed(*wait);
+    rig.lose();
+    EXPECT_EQ(kind(rig.take()), Req::kNone);
+    EXPECT_EQ(rig.status().state, GraspState::kApproaching);
+    EXPECT_EQ(rig.status().message, "waiting to close: no fresh track of the object (2.2 s left)");
+    rig.advance(1.5);
+    rig.lose();
+    EXPECT_EQ(kind(rig.take()), Req::kNone) << "still waiting at 2.3 s";
+    EXPECT_EQ(rig.status().state, GraspState::kApproaching);
+    rig.advance(1.0);  // 3.3 s after the command
+    if (returns) {
+      rig.feed_with_sigma(0.002);
+      EXPECT_EQ(kind(rig.take()), Req::kApproach) << rig.status().message;
+    } else {
+      rig.lose();
+      EXPECT_EQ(kind(rig.take()), Req::kMove) << "the back-off";
+      EXPECT_EQ(rig.status().activity, GraspActivity::kBackingOff);
+      EXPECT_EQ(rig.status().outcome, GraspOutcome::kFailed);
+      EXPECT_EQ(rig.status().message, "track lost");
+    }
+  }
+}
+
 // No trajectory newer than max_trajectory_age during the approach also counts as a lost track.
 TEST(GraspMachineTest, StaleTrackDuringApproachBacksOff) {
-  Rig rig;
+  GraspSettings s;
+  s.max_wait = 0;
+  Rig rig(s);
   reach(rig, At::kQ1);
   rig.advance(0.9);
   EXPECT_EQ(kind(rig.take()), Req::kApproach);  // still fresh: approaches
-  Rig late;
+  Rig late(s);
   reach(late, At::kQ1);
   late.advance(1.1);
   const std::optional<ArmRequest> r = late.take();
@@ -1062,7 +1107,9 @@ TEST(GraspMachineTest, GraspWithTheHandNotReportedOpenOpensFirst) {
 
 // A back-off that the lost track calls for while a0 is pending goes out after the a0.
 TEST(GraspMachineTest, OpenGoesBeforeABackoff) {
-  Rig rig({}, Status::GRIPPER_UNKNOWN);
+  GraspSettings s;
+  s.max_wait = 0;  // the back-off at once
+  Rig rig(s, Status::GRIPPER_UNKNOWN);
   rig.feed();
   rig.command(GraspCommand::kGrasp);
   rig.lose();

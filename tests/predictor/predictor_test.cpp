@@ -198,8 +198,10 @@ TEST(Predictor, GateDropsOutliersButNotARealJump) {
 }
 
 // Occlusion: fed-back samples carry the track (status OCCLUDED, counted), stay near the truth,
-// and the track recovers when the ball is seen again; after 16 fed-back samples it is lost.
+// and the track recovers when the ball is seen again; after max_gap (24) fed-back samples it is
+// lost.
 TEST(Predictor, OcclusionFeedbackRecoveryAndLoss) {
+  ASSERT_EQ(params_4hz().max_gap, 24);
   TrajectoryPredictor predictor(params_4hz());
   int64_t k = 0;
   auto step = [&](bool visible) {
@@ -223,7 +225,11 @@ TEST(Predictor, OcclusionFeedbackRecoveryAndLoss) {
   EXPECT_EQ(back[0].status, TrackStatus::kTracking);
   EXPECT_EQ(back[0].occluded_samples, 0);
   EXPECT_LT((back[0].positions[0] - circle(static_cast<double>(k) * 0.25)).norm(), 0.002);
-  for (int i = 0; i < 16; ++i) step(false);
+  for (int i = 0; i < 24; ++i) {
+    const auto f = step(false);
+    ASSERT_FALSE(f.empty());
+    EXPECT_EQ(f.back().status, TrackStatus::kOccluded) << i;
+  }
   const auto lost = step(false);
   ASSERT_FALSE(lost.empty());
   EXPECT_EQ(lost.back().status, TrackStatus::kLost);
