@@ -578,16 +578,21 @@ TEST(GraspMachineTest, FarApproachClosesInFirst) {
   EXPECT_EQ(rig.status().state, GraspState::kGrasping);
 }
 
+/// Tracking, then a grasp asked for with a fresh trajectory whose points carry `sigma` per axis.
+void grasp_while_tracking(Rig& rig, double sigma) {
+  reach(rig, At::kQ0Tracking);
+  rig.run();
+  rig.advance(0.8);
+  rig.feed_with_sigma(sigma);
+  rig.command(GraspCommand::kGrasp);
+}
+
 // A forecast too unsure for the gripper (2 sigma of 0.02 m per axis is 69 mm > 20 mm) keeps the
 // arm tracking above the ball in q1 and says so; a sure one (0.002 m per axis: 2 x sqrt(12e-6 +
 // arm 1e-6 + (15.7 mm/s x 0.035 s)^2) = 7.3 mm) sends the approach with the CLOSE.
 TEST(GraspMachineTest, WaitsToCloseUntilTheForecastIsSure) {
   Rig rig;
-  reach(rig, At::kQ0Tracking);
-  rig.run();
-  rig.advance(0.8);
-  rig.feed_with_sigma(0.02);
-  rig.command(GraspCommand::kGrasp);
+  grasp_while_tracking(rig, 0.02);
   const std::optional<ArmRequest> wait = rig.take();
   ASSERT_EQ(kind(wait), Req::kMove) << rig.status().message;
   EXPECT_NEAR(wait->position.z(), 0.10 + rig.settings.standoff, 0.002);
@@ -611,11 +616,7 @@ TEST(GraspMachineTest, ClosesOnAGuessAfterMaxWait) {
   GraspSettings s;
   s.max_wait = 3.0;
   Rig rig(s);
-  reach(rig, At::kQ0Tracking);
-  rig.run();
-  rig.advance(0.8);
-  rig.feed_with_sigma(0.05);
-  rig.command(GraspCommand::kGrasp);
+  grasp_while_tracking(rig, 0.05);
   for (int i = 0; i < 3; ++i) {  // at 0, 0.8 and 1.6 s
     const std::optional<ArmRequest> wait = rig.take();
     ASSERT_EQ(kind(wait), Req::kMove) << i << ": " << rig.status().message;
@@ -636,11 +637,7 @@ TEST(GraspMachineTest, ConfidenceZeroClosesAtOnce) {
   GraspSettings s;
   s.confidence = 0;
   Rig rig(s);
-  reach(rig, At::kQ0Tracking);
-  rig.run();
-  rig.advance(0.8);
-  rig.feed_with_sigma(0.05);
-  rig.command(GraspCommand::kGrasp);
+  grasp_while_tracking(rig, 0.05);
   EXPECT_EQ(kind(rig.take()), Req::kApproach) << rig.status().message;
 }
 
@@ -761,11 +758,7 @@ TEST(GraspMachineTest, LostTrackWhileWaitingWaitsUpToMaxWait) {
   s.max_wait = 3.0;
   for (const bool returns : {true, false}) {
     Rig rig(s);
-    reach(rig, At::kQ0Tracking);
-    rig.run();
-    rig.advance(0.8);
-    rig.feed_with_sigma(0.05);
-    rig.command(GraspCommand::kGrasp);
+    grasp_while_tracking(rig, 0.05);
     const std::optional<ArmRequest> wait = rig.take();
     ASSERT_EQ(kind(wait), Req::kMove) << rig.status().message;
     rig.advance(0.8);
