@@ -11,8 +11,7 @@ ForecastError::ForecastError(int horizon, int max_gap, const ForecastErrorParams
     : horizon_(horizon), params_(p) {
   if (horizon < 1 || max_gap < 0 || p.window < 1 || p.window > kMaxWindow)
     throw std::invalid_argument(
-        "forecast error: horizon and window must be positive (window "
-        "at most " +
+        "forecast error: horizon and window must be positive (window at most " +
         std::to_string(kMaxWindow) + ")");
   if (!(p.prior_sigma > 0) || !std::isfinite(p.prior_sigma) || !(p.min_sigma > 0) ||
       !std::isfinite(p.min_sigma))
