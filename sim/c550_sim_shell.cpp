@@ -53,9 +53,7 @@ C550SimShell::C550SimShell(const C550SimSettings& settings, C550Controller& cont
   }
   bus_.subscribe<stereograsp::point3_t>(
       "GROUND_TRUTH", [this](const stereograsp::point3_t& p, const ReceiveInfo&) {
-        const Eigen::Vector3d centre(p.position[0], p.position[1], p.position[2]);
-        ball_ = centre.allFinite() ? std::optional(centre) : std::nullopt;
-        if (emulator_) emulator_->set_ball_centre(ball_);
+        ball_.add(p.utime, Eigen::Vector3d(p.position[0], p.position[1], p.position[2]));
       });
 }
 
@@ -84,7 +82,7 @@ double C550SimShell::now() const {
 void C550SimShell::connect() {
   pty_ = std::make_unique<PseudoTerminal>();
   emulator_ = std::make_unique<C550Emulator>(controller_, s_.slave);
-  emulator_->set_ball_centre(ball_);
+  emulator_->set_ball_centre(ball_.at(now_utime()));
   logged_ = 0;
   tx_.clear();
   link_.point_to(pty_->path());
@@ -128,6 +126,7 @@ void C550SimShell::wait(double seconds) {
 
 void C550SimShell::serve(double t) {
   if (!pty_) return;
+  emulator_->set_ball_centre(ball_.at(now_utime()));  // where the ball is now, for a CLOSE
   receive(t);
   if (emulator_->next_output_time() <= t) {
     for (const auto& chunk : emulator_->take_output_chunks(t)) faults_.apply(chunk, tx_);

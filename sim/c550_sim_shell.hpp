@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "common/bus.hpp"
+#include "sim/ball_track.hpp"
 #include "sim/c550_controller.hpp"
 #include "sim/c550_emulator.hpp"
 #include "sim/c550_sim_settings.hpp"
@@ -21,8 +22,9 @@ namespace sg::sim {
 stereograsp::sim_arm_state_t arm_state_message(const C550Controller& c550, double t, int64_t utime);
 
 /// sg-c550-sim's loop: the line (a pseudo-terminal that comes and goes, with its faults) and the
-/// controller (which stays), SIM_ARM_STATE out and GROUND_TRUTH in. Time is the steady clock's
-/// since construction; run() returns when shutdown is requested.
+/// controller (which stays), SIM_ARM_STATE out and GROUND_TRUTH in (the ball a CLOSE grasps,
+/// extrapolated from the last two frames to the moment it executes: BallTrack). Time is the steady
+/// clock's since construction; run() returns when shutdown is requested.
 class C550SimShell {
  public:
   /// `controller` and `bus` must outlive the shell. Throws when log_commands cannot be opened.
@@ -51,7 +53,7 @@ class C550SimShell {
   std::unique_ptr<PseudoTerminal> pty_;
   std::unique_ptr<C550Emulator> emulator_;
   std::deque<uint8_t> tx_;
-  std::optional<Eigen::Vector3d> ball_;
+  BallTrack ball_;  ///< GROUND_TRUTH, extrapolated to the moment a CLOSE executes
   size_t logged_ = 0;
   bool disconnected_ = false;
   double reconnect_at_ = 0;
