@@ -62,7 +62,8 @@ struct Histogram {
 };
 
 /// Everything the figures need (docs/logs.md):
-///  - xy.png, the paper's figure 5: the X-Y plane with measured, predicted and true paths;
+///  - xy.png, the paper's figure 5: the X-Y plane with measured, predicted and true paths, but
+///    none of their points while the arm holds the ball (`ball_held`);
 ///  - y_time.png, figure 6: Y against time, crosses for measurements, circles for predictions,
 ///    occlusions shaded;
 ///  - latency.png: a histogram per stage;
@@ -73,7 +74,10 @@ struct PlotData {
   DecimatedSeries truth;      ///< GROUND_TRUTH
   int predicted_horizon = 4;  ///< which step of each trajectory `predicted` holds
   std::vector<std::pair<double, double>> occlusions;  ///< [start, end), seconds
-  std::map<std::string, Histogram> latency_ms;        ///< per stage, milliseconds
+  /// [start, end), seconds: while the arm holds the ball (the calibration, the carried ball:
+  /// logger/session_phase.hpp); xy.png leaves the points in them out.
+  std::vector<std::pair<double, double>> ball_held;
+  std::map<std::string, Histogram> latency_ms;  ///< per stage, milliseconds
   DecimatedSeries arm_target;  ///< ARM_COMMAND Cartesian targets, at the command's time
   DecimatedSeries arm_actual;  ///< ARM_STATUS tool positions
   std::vector<std::pair<double, std::string>> events;  ///< grasp states and outcomes, at time

@@ -186,6 +186,23 @@ Json j_prediction(const std::vector<HorizonSummary>& list) {
   return prediction;
 }
 
+/// report.json's "prediction_by_phase": per phase, its time and per horizon the errors there.
+Json j_prediction_by_phase(const std::vector<PhasePrediction>& list) {
+  Json phases = Json::array();
+  for (const PhasePrediction& p : list) {
+    Json horizons = Json::array();
+    for (const PhaseHorizon& h : p.horizons)
+      horizons.push_back({{"h", h.h},
+                          {"vs_measurement_m", j_quantiles(h.vs_measurement)},
+                          {"vs_truth_m", j_quantiles(h.vs_truth)}});
+    phases.push_back({{"phase", p.key},
+                      {"name", p.phase},
+                      {"duration_s", j_num(p.duration_s)},
+                      {"horizons", horizons}});
+  }
+  return phases;
+}
+
 /// report.json's "occlusions": totals and each episode with the prediction error in and after it.
 Json j_occlusions(const OcclusionSummary& o) {
   Json episodes = Json::array();
@@ -241,6 +258,7 @@ std::string report_json(const SessionSummary& s) {
   j["latency_ms"] = j_latency(s.latency);
   j["histogram_bin_ratio"] = std::pow(10.0, 1.0 / 20);
   j["prediction"] = j_prediction(s.prediction);
+  j["prediction_by_phase"] = j_prediction_by_phase(s.prediction_by_phase);
   j["occlusions"] = j_occlusions(s.occlusions);
   j["arm"] = j_arm(s.arm);
   j["grasp"] = j_grasp(s.grasp);
@@ -372,6 +390,35 @@ void md_prediction(std::ostream& o, const std::vector<HorizonSummary>& predictio
       << ", " << num(h.vs_truth.max, 4) << " | " << h.unmatched_truth << " |\n";
 }
 
+/// One "n, RMS, p95, max" cell in millimetres ("–" for none).
+std::string mm_cell(const Quantiles& q) {
+  if (q.count == 0) return "–";
+  return std::to_string(q.count) + ", " + num(q.rms * 1e3, 2) + ", " + num(q.p95 * 1e3, 2) + ", " +
+         num(q.max * 1e3, 2);
+}
+
+/// "Prediction error by phase" (when any prediction was scored): a row per phase and horizon.
+void md_prediction_by_phase(std::ostream& o, const std::vector<PhasePrediction>& phases) {
+  bool scored = false;
+  for (const PhasePrediction& p : phases)
+    for (const PhaseHorizon& h : p.horizons)
+      scored = scored || h.vs_measurement.count > 0 || h.vs_truth.count > 0;
+  if (!scored) return;
+  o << "\n## Prediction error by phase\n\nThe same errors, in millimetres, by the phase of the "
+       "session that a prediction was made in and its target lies in (docs/logs.md, "
+       "\"Phases\"): in the calibration and the carried phase the arm moves the ball; coasting: "
+       "made on fed-back samples through an occlusion; across phases: made in one phase for a "
+       "time in another.\n\n| phase | time s | h | vs measurement: n, RMS, p95, max | vs truth: "
+       "n, RMS, p95, max |\n|---|---:|---:|---|---|\n";
+  for (const PhasePrediction& p : phases) {
+    for (const PhaseHorizon& h : p.horizons) {
+      if (h.vs_measurement.count == 0 && h.vs_truth.count == 0) continue;
+      o << "| " << p.phase << " | " << num(p.duration_s, 1) << " | " << h.h << " | "
+        << mm_cell(h.vs_measurement) << " | " << mm_cell(h.vs_truth) << " |\n";
+    }
+  }
+}
+
 /// "Occlusions": totals, then a row per episode with the prediction error in and after it.
 void md_occlusions(std::ostream& o, const OcclusionSummary& occlusions) {
   o << "\n## Occlusions\n\n"
@@ -443,6 +490,7 @@ std::string report_markdown(const SessionSummary& s, const std::vector<std::stri
   md_triangulation(o, s.triangulation);
   md_latency(o, s.latency);
   md_prediction(o, s.prediction);
+  md_prediction_by_phase(o, s.prediction_by_phase);
   md_occlusions(o, s.occlusions);
   md_arm(o, s.arm);
   md_grasping(o, s.grasp);
@@ -475,6 +523,13 @@ std::string summary_text(const SessionSummary& s) {
     if (h.vs_measurement.count > 0 || h.vs_truth.count > 0)
       o << "prediction h=" << h.h << ": RMS " << num(h.vs_measurement.rms, 4)
         << " m vs measurement, " << num(h.vs_truth.rms, 4) << " m vs truth\n";
+  for (const PhasePrediction& p : s.prediction_by_phase) {
+    if (p.key != "tracking") continue;
+    for (const PhaseHorizon& h : p.horizons)
+      if (h.vs_measurement.count > 0 || h.vs_truth.count > 0)
+        o << "prediction h=" << h.h << " while tracking: RMS " << num(h.vs_measurement.rms * 1e3, 2)
+          << " mm vs measurement, " << num(h.vs_truth.rms * 1e3, 2) << " mm vs truth\n";
+  }
   if (s.occlusions.count > 0)
     o << "occlusions: " << s.occlusions.count << ", longest " << num(s.occlusions.longest_s, 2)
       << " s\n";

@@ -197,15 +197,46 @@ std::pair<Span, Span> plane_ranges(const std::vector<const DecimatedSeries*>& se
   return {Span{cx - half, cx + half}, Span{cy - half, cy + half}};
 }
 
+// The points of a series outside the spans (sorted, apart), so figure 5 leaves out the ball that
+// the arm holds.
+DecimatedSeries outside(const DecimatedSeries& series,
+                        const std::vector<std::pair<double, double>>& spans) {
+  DecimatedSeries kept(series.points().size() + 2);  // room for all: nothing thinned again
+  for (const TimedPoint& p : series.points()) {
+    auto after = std::upper_bound(spans.begin(), spans.end(), p.t,
+                                  [](double t, const auto& span) { return t < span.first; });
+    const bool inside = after != spans.begin() && p.t < std::prev(after)->second;
+    if (!inside) kept.add(p.t, p.p);
+  }
+  return kept;
+}
+
+// A comment in xy.gp naming the spans left out.
+std::string held_note(const PlotData& data) {
+  if (data.ball_held.empty()) return "";
+  std::string out = "# left out: the points while the arm holds the ball (start, end in s):";
+  for (const auto& [start, end] : data.ball_held) {
+    out += ' ';
+    out += gnuplot_number(start);
+    out += '-';
+    out += gnuplot_number(end);
+  }
+  out += '\n';
+  return out;
+}
+
 std::string xy_figure(const PlotData& data, const std::string& dir) {
   const Box box{800, 800, 90, 760, 70, 740};  // a square axes box
+  const DecimatedSeries true_path = outside(data.truth, data.ball_held);
+  const DecimatedSeries measured_path = outside(data.measured, data.ball_held);
+  const DecimatedSeries predicted_path = outside(data.predicted, data.ball_held);
   GnuplotData dat;
   const int truth =
-      dat.add_block("true (GROUND_TRUTH): X (m), Y (m)", rows_of(data.truth, {0, 1}, true));
+      dat.add_block("true (GROUND_TRUTH): X (m), Y (m)", rows_of(true_path, {0, 1}, true));
   const int measured = dat.add_block("measured (OBJECT_POSITION): X (m), Y (m)",
-                                     rows_of(data.measured, {0, 1}, false));
+                                     rows_of(measured_path, {0, 1}, false));
   const int predicted = dat.add_block(horizon_title(data) + " (OBJECT_TRAJECTORY): X (m), Y (m)",
-                                      rows_of(data.predicted, {0, 1}, true));
+                                      rows_of(predicted_path, {0, 1}, true));
   std::vector<std::string> clauses;
   const std::string file = "xy.dat";
   if (truth >= 0)
@@ -218,9 +249,9 @@ std::string xy_figure(const PlotData& data, const std::string& dir) {
     clauses.push_back(
         series(file, predicted, "1:2", "lines lw 1", palette::kOrange, horizon_title(data)));
   }
-  const auto [x, y] = plane_ranges({&data.truth, &data.measured, &data.predicted});
-  const std::string script = preamble("xy", box.width, box.height) + axes_at(box) +
-                             key_row(box, 38) +
+  const auto [x, y] = plane_ranges({&true_path, &measured_path, &predicted_path});
+  const std::string script = preamble("xy", box.width, box.height) + held_note(data) +
+                             axes_at(box) + key_row(box, 38) +
                              title_row(box, "Ball in the X-Y plane (paper figure 5)") +
                              "set xlabel 'X (m)'\nset ylabel 'Y (m)'\n" + range("x", x.lo, x.hi) +
                              range("y", y.lo, y.hi) + plot_command(clauses, true);

@@ -7,7 +7,8 @@
 ///
 ///  - xy (the paper's figure 5): the ball in the X-Y plane of the robot frame, metres, equal
 ///    aspect: the true path (green line), the measured positions (small blue crosses) and the
-///    predicted path at h = data.predicted_horizon steps ahead (orange line).
+///    predicted path at h = data.predicted_horizon steps ahead (orange line); points whose time
+///    lies in data.ball_held (the calibration, the carried ball) are left out.
 ///  - y_time (figure 6): Y against time: occlusions shaded light orange, truth as a green line,
 ///    measurements as blue crosses, predictions as orange circles, and grasp events as purple
 ///    dashed vertical markers with their names.

@@ -243,14 +243,22 @@ struct Sample {
 struct Pending {
   int64_t target;
   Vec3 p;
+  Phase made;           // the phase when its trajectory was received
+  bool coasting;        // made on fed-back samples (an occlusion)
+  int64_t target_recv;  // its target time on the log's clock
 };
+
+// The rows of the per-phase figures: each Phase, then these two.
+constexpr int kCoastingRow = kPhaseCount, kAcrossRow = kPhaseCount + 1,
+              kPhaseRows = kPhaseCount + 2;
 
 /// A reference stream (measurements or truth) and the predictions waiting for it.
 struct Reference {
-  std::deque<Sample> recent;                 // the last few samples, oldest first
-  std::vector<std::deque<Pending>> pending;  // per horizon, in target order
-  std::vector<ErrorStats> error;             // per horizon
-  std::vector<int64_t> unmatched;            // per horizon
+  std::deque<Sample> recent;                      // the last few samples, oldest first
+  std::vector<std::deque<Pending>> pending;       // per horizon, in target order
+  std::vector<ErrorStats> error;                  // per horizon
+  std::vector<std::vector<ErrorStats>> by_phase;  // per horizon, per row (kPhaseRows)
+  std::vector<int64_t> unmatched;                 // per horizon
   static constexpr size_t kRecent = 16;
   static constexpr size_t kMaxPending = 4096;
 };
@@ -303,8 +311,33 @@ struct SessionStats::Impl {
   bool have_grasp = false;
   int last_state = -100, last_outcome = -100;
   PlotData* plots = nullptr;
+  // phases
+  SessionPhase phases;
+  bool held_open = false;  // a span of plots->ball_held is open
 
   double t(int64_t utime) const { return seconds(utime - t0); }
+
+  /// Opens or closes a span of plots->ball_held as the arm takes or lets go of the ball (the
+  /// first kMaxEvents spans).
+  void follow_phase(int64_t recv) {
+    if (!plots) return;
+    const bool held = holds_the_ball(phases.current());
+    if (held && !held_open && plots->ball_held.size() < SessionStats::kMaxEvents) {
+      plots->ball_held.emplace_back(t(recv), t(recv));
+      held_open = true;
+    } else if (!held && held_open) {
+      plots->ball_held.back().second = t(recv);
+      held_open = false;
+    }
+  }
+
+  /// The row a scored prediction goes to: its phase when made and at its target time alike.
+  int phase_row(const Pending& pe) const {
+    const std::optional<Phase> then = phases.at(pe.target_recv);
+    if (!then || *then != pe.made) return kAcrossRow;
+    if (pe.coasting && !holds_the_ball(pe.made)) return kCoastingRow;
+    return static_cast<int>(pe.made);
+  }
 
   void latency_of(const std::string& stage, const char* reference, int64_t recv, int64_t ref) {
     if (ref == 0) return;
@@ -331,14 +364,14 @@ struct SessionStats::Impl {
     return nullptr;
   }
 
-  void record(Reference& ref, bool is_truth, size_t hi, int64_t target, const Vec3& predicted,
-              const Vec3& actual) {
-    const double e = (predicted - actual).norm();
+  void record(Reference& ref, bool is_truth, size_t hi, const Pending& pe, const Vec3& actual) {
+    const double e = (pe.p - actual).norm();
     ref.error[hi].add(e);
+    ref.by_phase[hi][static_cast<size_t>(phase_row(pe))].add(e);
     if (is_truth) {
-      if (EpisodeState* ep = episode_containing(target)) ep->vs_truth.add(e);
+      if (EpisodeState* ep = episode_containing(pe.target)) ep->vs_truth.add(e);
     } else {
-      if (EpisodeState* ep = episode_before(target)) ep->after.add(e);
+      if (EpisodeState* ep = episode_before(pe.target)) ep->after.add(e);
     }
   }
 
@@ -367,7 +400,7 @@ struct SessionStats::Impl {
       while (!q.empty() && q.front().target <= utime) {
         const Pending& pe = q.front();
         if (auto actual = bracket(ref, pe.target)) {
-          record(ref, is_truth, hi, pe.target, pe.p, *actual);
+          record(ref, is_truth, hi, pe, *actual);
         } else {
           ++ref.unmatched[hi];
         }
@@ -376,8 +409,8 @@ struct SessionStats::Impl {
     }
   }
 
-  void add_prediction(Reference& ref, bool is_truth, size_t hi, int64_t target, const Vec3& p,
-                      int64_t recv) {
+  void add_prediction(Reference& ref, bool is_truth, size_t hi, const Pending& pe, int64_t recv) {
+    const int64_t target = pe.target;
     auto& q = ref.pending[hi];
     // Drop what can no longer be matched: its reference would have been logged long ago.
     while (!q.empty() &&
@@ -387,7 +420,7 @@ struct SessionStats::Impl {
     }
     if (!ref.recent.empty() && target <= ref.recent.back().utime) {
       if (auto actual = bracket(ref, target)) {
-        record(ref, is_truth, hi, target, p, *actual);
+        record(ref, is_truth, hi, pe, *actual);
       } else {
         ++ref.unmatched[hi];
       }
@@ -396,7 +429,7 @@ struct SessionStats::Impl {
     if (!q.empty() && target < q.back().target) {  // a restarted predictor: keep the order
       q.clear();
     }
-    q.push_back({target, p});
+    q.push_back(pe);
   }
 
   void open_episode(int64_t start, bool gap) {
@@ -504,15 +537,20 @@ struct SessionStats::Impl {
         !episodes.empty() && episodes.back().end == std::numeric_limits<int64_t>::max())
       ++episodes.back().e.occluded_trajectories;
     const int n = std::min<int>(m.num_points, static_cast<int>(m.position.size()));
+    // The log's clock at a target: the trajectory's receive time plus how far ahead it looks.
+    const int64_t made_utime = m.source_utime != 0 ? m.source_utime : m.utime;
+    const bool coasting =
+        m.occluded_samples > 0 || m.status == stereograsp::trajectory_t::STATUS_OCCLUDED;
     for (size_t hi = 0; hi < options.horizons.size(); ++hi) {
       const int h = options.horizons[hi];
       if (h < 1 || h > n || m.position[h - 1].size() != 3) continue;
       const Vec3 p(m.position[h - 1][0], m.position[h - 1][1], m.position[h - 1][2]);
       if (!finite3(p)) continue;
       const int64_t target = m.start_utime + static_cast<int64_t>(h - 1) * m.period_us;
+      const Pending pe{target, p, phases.current(), coasting, recv + (target - made_utime)};
       ++predictions[hi];
-      add_prediction(measured, false, hi, target, p, recv);
-      add_prediction(truth, true, hi, target, p, recv);
+      add_prediction(measured, false, hi, pe, recv);
+      add_prediction(truth, true, hi, pe, recv);
     }
     if (plots) {
       const int h = plots->predicted_horizon;
@@ -526,6 +564,7 @@ struct SessionStats::Impl {
 
   void on_arm_command(int64_t recv, const stereograsp::arm_cmd_t& c) {
     latency_of("ARM_COMMAND", "source_utime", recv, c.source_utime);
+    phases.on_arm_command(recv);
     ++arm.commands;
     ++arm.command_modes[mode_name(c.mode)];
     if (c.mode == stereograsp::arm_cmd_t::MODE_CARTESIAN && plots) {
@@ -558,6 +597,7 @@ struct SessionStats::Impl {
   void on_grasp_status(int64_t recv, const stereograsp::grasp_status_t& g) {
     latency_of("GRASP_STATUS", "source_utime", recv, g.source_utime);
     ++grasp.statuses;
+    phases.on_grasp_status(recv, g.state, g.activity);
     const bool state_changed = g.state != last_state;
     const bool outcome_changed = g.outcome != last_outcome;
     if (outcome_changed && have_grasp) {
@@ -618,6 +658,7 @@ struct SessionStats::Impl {
   void on_message(const std::string& channel, int64_t recv,
                   const stereograsp::sim_arm_state_t& msg) {
     latency_of(channel, "utime", recv, msg.utime);
+    if (channel == "SIM_ARM_STATE") phases.on_sim_arm_state(recv, msg.holding_object);
   }
   template <class T>
   void on_message(const std::string&, int64_t, const T&) {}
@@ -730,6 +771,30 @@ struct SessionStats::Impl {
       h.unmatched_truth = truth.unmatched[hi] + static_cast<int64_t>(truth.pending[hi].size());
       s.prediction.push_back(h);
     }
+    summarize_phases(s);
+  }
+
+  // Per phase (then coasting, then across phases), per horizon: the errors scored there.
+  void summarize_phases(SessionSummary& s) const {
+    s.prediction_by_phase.clear();
+    for (int row = 0; row < kPhaseRows; ++row) {
+      PhasePrediction p;
+      if (row < kPhaseCount) {
+        const Phase phase = static_cast<Phase>(row);
+        p.phase = phase_name(phase);
+        p.key = phase_key(phase);
+        p.duration_s = phases.seconds_in(phase);
+      } else {
+        p.phase = row == kCoastingRow ? "coasting" : "across phases";
+        p.key = row == kCoastingRow ? "coasting" : "across_phases";
+      }
+      for (size_t hi = 0; hi < options.horizons.size(); ++hi) {
+        const size_t r = static_cast<size_t>(row);
+        p.horizons.push_back({options.horizons[hi], quantiles(measured.by_phase[hi][r].hist),
+                              quantiles(truth.by_phase[hi][r].hist)});
+      }
+      s.prediction_by_phase.push_back(std::move(p));
+    }
   }
 
   // Occlusion episodes; one still open at the end closes at the last position.
@@ -754,6 +819,7 @@ SessionStats::SessionStats(StatsOptions options) : impl_(std::make_unique<Impl>(
   for (Reference* r : {&impl_->measured, &impl_->truth}) {
     r->pending.resize(n);
     r->error.resize(n);
+    r->by_phase.assign(n, std::vector<ErrorStats>(kPhaseRows));
     r->unmatched.assign(n, 0);
   }
   impl_->predictions.assign(n, 0);
@@ -772,6 +838,14 @@ void SessionStats::add(const std::string& channel, int64_t recv, const uint8_t* 
                        int64_t offset) {
   Impl& m = *impl_;
   m.count_event(recv);
+  m.phases.advance(recv);
+  add_event(channel, recv, data, size, offset);
+  m.follow_phase(recv);
+}
+
+void SessionStats::add_event(const std::string& channel, int64_t recv, const uint8_t* data,
+                             int size, int64_t offset) {
+  Impl& m = *impl_;
   if (channel == "LCM_SELF_TEST") {
     UnknownChannel& u = m.internal[channel];
     u.name = channel;
@@ -837,6 +911,7 @@ void SessionStats::finish() {
   }
   m.summarize_prediction(s);
   m.summarize_occlusions(s);
+  if (m.held_open) plots_.ball_held.back().second = m.t(m.last);
   s.arm = m.arm;
   s.arm.interaction_s = quantiles(m.interaction);
   s.grasp = m.grasp;

@@ -17,6 +17,10 @@
 /// decade, 1.2 %), and exact when the bin holds one distinct value (a constant latency, a
 /// regular period). Means, RMS, minima and maxima are exact.
 ///
+/// Phases: the prediction error is given for the whole session and per phase (the calibration,
+/// the grasp machine idle, tracking, the approach, the carried ball: logger/session_phase.hpp),
+/// each a fixed set of histograms; the phase changes are kept, the last 4096.
+///
 /// Which message is what: a message's type is its fingerprint (the first 8 bytes, big-endian,
 /// compared with each type's getHash()); a channel's expected type is its name
 /// (docs/architecture.md): a known fingerprint on the wrong channel is "wrong type", a known
@@ -36,6 +40,7 @@
 
 #include "logger/log_reader.hpp"
 #include "logger/plot_data.hpp"
+#include "logger/session_phase.hpp"
 
 namespace sg::logger {
 
@@ -138,6 +143,25 @@ struct HorizonSummary {
   int64_t unmatched_truth = 0;
 };
 
+/// Prediction error at one horizon within one phase of the session, metres.
+struct PhaseHorizon {
+  int h = 0;
+  Quantiles vs_measurement;  ///< against OBJECT_POSITION, interpolated at the target time
+  Quantiles vs_truth;        ///< against GROUND_TRUTH
+};
+
+/// The predictions of one phase of the session (logger/session_phase.hpp). A prediction counts
+/// in a phase when it was made in it (its OBJECT_TRAJECTORY received then) and its target time
+/// lies in it too; "coasting" holds those made on fed-back samples through an occlusion (in a
+/// phase where the ball follows its own path), "across phases" those whose target lies in
+/// another phase than the one they were made in (or before the phase changes kept).
+struct PhasePrediction {
+  std::string phase;         ///< phase_name(), "coasting" or "across phases"
+  std::string key;           ///< for report.json: phase_key(), "coasting" or "across_phases"
+  double duration_s = kNaN;  ///< time spent in the phase (NaN for the last two)
+  std::vector<PhaseHorizon> horizons;  ///< as StatsOptions::horizons
+};
+
 /// A run of OBJECT_POSITION with visible = false (or a gap in it longer than 0.5 s).
 struct OcclusionEpisode {
   double start_s = 0;     ///< session time (capture time) of the first unseen frame
@@ -211,7 +235,9 @@ struct SessionSummary {
   std::vector<CameraSummary> cameras;
   TriangulationSummary triangulation;
   std::vector<LatencySummary> latency;
-  std::vector<HorizonSummary> prediction;
+  std::vector<HorizonSummary> prediction;  ///< every prediction, whatever the phase
+  /// Per phase: each Phase in order, then "coasting", then "across phases".
+  std::vector<PhasePrediction> prediction_by_phase;
   OcclusionSummary occlusions;
   ArmSummary arm;
   GraspSummary grasp;
@@ -256,6 +282,9 @@ class SessionStats {
 
  private:
   struct Impl;
+  // One event, after the clock and the phase have moved to its receive time.
+  void add_event(const std::string& channel, int64_t recv, const uint8_t* data, int size,
+                 int64_t offset);
   std::unique_ptr<Impl> impl_;
   SessionSummary summary_;
   PlotData plots_;

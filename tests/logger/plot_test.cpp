@@ -253,6 +253,26 @@ TEST(SessionPlots, WritesFourFigures) {
             std::string::npos);
 }
 
+// Figure 5 leaves out the points while the arm holds the ball (ball_held: the calibration to
+// 2.025 s, the carried ball from 15.025 s): truth at 2.05..15.0 s (260 points), measured there
+// but in the occlusion (119 + 100), predicted with targets there (t + 1: 260); figure 6 keeps all.
+TEST(SessionPlots, FigureFiveLeavesOutTheHeldBall) {
+  const TempDir temp;
+  PlotData data = synthetic_session();
+  data.ball_held = {{0.0, 2.025}, {15.025, 21.0}};
+  write_session_plots(data, temp.path);
+  const std::string xy = test::read_text(temp.path + "/xy.dat");
+  EXPECT_EQ(test::count_lines(xy), 3 + 260 + 219 + 260 + 2 * 2);
+  EXPECT_EQ(xy.find("\n0.65 0\n"), std::string::npos);  // the truth at t = 0 is left out
+  const std::string y_time = test::read_text(temp.path + "/y_time.dat");
+  EXPECT_EQ(test::count_lines(y_time), 3 + 400 + 400 + 359 + 2 * 2);
+  EXPECT_NE(test::read_text(temp.path + "/xy.gp")
+                .find("# left out: the points while the arm "
+                      "holds the ball (start, end in s): 0-2.025 "
+                      "15.025-21\n"),
+            std::string::npos);
+}
+
 // A script re-run by hand in its directory draws the same figure again.
 TEST(SessionPlots, ScriptsRerunByHand) {
   const TempDir temp;
