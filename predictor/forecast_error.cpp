@@ -16,6 +16,10 @@ ForecastError::ForecastError(int horizon, int max_gap, const ForecastErrorParams
   if (!(p.prior_sigma > 0) || !std::isfinite(p.prior_sigma) || !(p.min_sigma > 0) ||
       !std::isfinite(p.min_sigma))
     throw std::invalid_argument("forecast error: prior_sigma and min_sigma must be positive");
+  if (p.surprise_window < 0 || p.surprise_window > 64 || !(p.surprise_threshold > 0) ||
+      !std::isfinite(p.surprise_threshold))
+    throw std::invalid_argument(
+        "forecast error: surprise_window must be 0 to 64 and surprise_threshold positive");
   const size_t n = static_cast<size_t>(horizon) + static_cast<size_t>(max_gap);
   const size_t w = static_cast<size_t>(p.window);
   window_.assign(n * w, Eigen::Vector3d::Zero());
@@ -25,6 +29,10 @@ ForecastError::ForecastError(int horizon, int max_gap, const ForecastErrorParams
   filled_.assign(n, 1);
   head_.assign(n, 1 % p.window);
   scores_.assign(n, 0);
+  surprise_ring_.assign(n * static_cast<size_t>(p.surprise_window), 0.0);
+  surprise_sum_.assign(n, 0.0);
+  surprise_filled_.assign(n, 0);
+  rho_.assign(n, 1.0);
   for (size_t b = 0; b < n; ++b) {  // the prior is each window's first entry
     const double s = p.prior_sigma * static_cast<double>(b + 1);
     window_[b * w] = sum_[b] = Eigen::Vector3d::Constant(s * s);
@@ -102,8 +110,38 @@ void ForecastError::score(int64_t utime, const Eigen::Vector3d& sample,
     const Eigen::Vector3d e = sample - k.positions[static_cast<size_t>(h - 1)];
     if (!(e.cwiseAbs().maxCoeff() <= 1e6)) continue;  // NaN too
     const size_t b = bucket(h + k.occluded);
+    const Eigen::Vector3d s = estimate(b);
+    add_surprise(b, (e.cwiseAbs2().array() / (s.cwiseAbs2() + noise).array()).mean());
     add(b, e.cwiseAbs2(), noise);
     ++scores_[b];
+  }
+  update_surprise();
+}
+
+void ForecastError::add_surprise(size_t b, double z2) {
+  const int w = params_.surprise_window;
+  if (w == 0 || !std::isfinite(z2)) return;
+  // The ring's slot: scores_ counts every score, so it cycles through the window.
+  double& slot = surprise_ring_[b * static_cast<size_t>(w) + static_cast<size_t>(scores_[b] % w)];
+  if (surprise_filled_[b] == w) surprise_sum_[b] -= slot;
+  slot = std::min(z2, 1e12);
+  surprise_sum_[b] += slot;
+  surprise_filled_[b] = std::min(surprise_filled_[b] + 1, w);
+  if (scores_[b] % w == w - 1) {  // once a round, the sum afresh (no rounding drift)
+    surprise_sum_[b] = 0;
+    const double* ring = &surprise_ring_[b * static_cast<size_t>(w)];
+    for (int i = 0; i < surprise_filled_[b]; ++i) surprise_sum_[b] += ring[i];
+  }
+}
+
+void ForecastError::update_surprise() {
+  double rho = 1.0;
+  for (size_t b = 0; b < rho_.size(); ++b) {
+    if (surprise_filled_[b] > 0) {
+      const double mean = surprise_sum_[b] / surprise_filled_[b];
+      rho = std::max(rho, std::sqrt(std::max(0.0, mean) / params_.surprise_threshold));
+    }
+    rho_[b] = rho;
   }
 }
 
@@ -113,13 +151,18 @@ void ForecastError::reset() {
   scored_ = false;
 }
 
+Eigen::Vector3d ForecastError::estimate(size_t b) const {
+  const Eigen::Vector3d square = (sum_[b] - noise_sum_[b]) / static_cast<double>(filled_[b]);
+  return square.cwiseMax(0).cwiseSqrt().cwiseMax(params_.min_sigma);
+}
+
 Eigen::Vector3d ForecastError::sigma(int samples) const {
   const size_t b = bucket(samples);
-  const double m = static_cast<double>(filled_[b]);
-  const Eigen::Vector3d square = (sum_[b] - noise_sum_[b]) / m;
-  const double widen = params_.predictive ? predictive_factor(m) : 1.0;
-  return widen * square.cwiseMax(0).cwiseSqrt().cwiseMax(params_.min_sigma);
+  const double widen = params_.predictive ? predictive_factor(filled_[b]) : 1.0;
+  return widen * rho_[b] * estimate(b);
 }
+
+double ForecastError::surprise(int samples) const { return rho_[bucket(samples)]; }
 
 int64_t ForecastError::scores(int samples) const { return scores_[bucket(samples)]; }
 

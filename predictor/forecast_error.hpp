@@ -23,7 +23,23 @@
 /// predictive_factor() (Student's t for the m scores) unless params.predictive is false.
 /// r is the measured sample's own sigma (zero when not known): taken out, what is estimated is
 /// the forecast's error against where the ball is, which a grasp needs, not against a noisy
-/// measurement of it. sigma(b) is sqrt(max(s_b^2, 0)), at least min_sigma. The estimates survive
+/// measurement of it. sigma(b) is sqrt(max(s_b^2, 0)), at least min_sigma.
+///
+/// A turn seen widens every longer horizon at once (issue 17). The window above hears of a change
+/// of motion (the drift's reversal) at horizon b only b samples after it, when the forecasts made
+/// before it come due; a grasp planned on sigma(7) in between closes on an old certainty. So each
+/// bucket also keeps its last `surprise_window` normalized squared errors
+///
+///     z^2 = (1/3) sum over the axes of e_i^2 / (s_b,i^2 + r_i^2),   (s_b from before the score)
+///
+/// whose mean is 1 for a calibrated estimate, and its surprise rho_b = sqrt(mean z^2 / c), at
+/// least 1 (c = surprise_threshold, so chance alone seldom widens). sigma(b) is multiplied by
+///
+///     rho*_b = max over b' <= b of rho_b',
+///
+/// so a large h = 1 error, seen one sample after the turn, widens h = 1 .. H + max_gap, and the
+/// widening lasts as long as any shorter horizon is still surprised (docs/prediction.md).
+/// The estimates survive
 /// reset() (they describe the predictor on this motion, not one track); the kept forecasts do not
 /// (their grid is gone).
 ///
@@ -48,6 +64,10 @@ struct ForecastErrorParams {
   /// sigma() widened by predictive_factor(m): 2 sigma then bounds the next error as often as a
   /// normal's 2 sigma does, although s is estimated from m scores (Student's t). false: s itself.
   bool predictive = true;
+  /// Scores a bucket's surprise averages (0: no widening on surprise; at most 64).
+  int surprise_window = 4;
+  /// Mean z^2 above which a bucket is surprised (rho = sqrt(mean / this)).
+  double surprise_threshold = 1.5;
 };
 
 class ForecastError {
@@ -80,6 +100,8 @@ class ForecastError {
   /// 1-sigma error per axis (m) of a point `samples` grid samples past the last measurement
   /// (1 .. horizon + max_gap; clamped into that range).
   Eigen::Vector3d sigma(int samples) const;
+  /// rho*_b: the surprise factor sigma(samples) includes (1 when nothing surprised).
+  double surprise(int samples) const;
   /// Scores the estimate of that horizon has had (0 .. ; the prior not counted).
   int64_t scores(int samples) const;
   /// t_{m-1}(0.97725) sqrt(1 + 1/m) / 2, at most 2: how much wider than 2 s a 2-sigma interval
@@ -98,6 +120,12 @@ class ForecastError {
   size_t bucket(int samples) const;
   /// Adds e^2 and r^2 to bucket b's window, dropping its oldest entry when it is full.
   void add(size_t b, const Eigen::Vector3d& value, const Eigen::Vector3d& noise);
+  /// sigma(b) without the predictive factor or the surprise: s_b.
+  Eigen::Vector3d estimate(size_t b) const;
+  /// Adds z^2 to bucket b's surprise ring.
+  void add_surprise(size_t b, double z2);
+  /// rho*_b afresh for every bucket (after a sample's scores).
+  void update_surprise();
 
   int horizon_;
   ForecastErrorParams params_;
@@ -108,10 +136,14 @@ class ForecastError {
   std::vector<int> filled_;                 // per bucket: entries in its ring (the prior the first)
   std::vector<int> head_;                   // per bucket: where its next entry goes
   std::vector<int64_t> scores_;
-  std::vector<Kept> kept_;  // a ring of the last `horizon` forecasts
-  size_t next_ = 0;         // where the next forecast goes
-  size_t count_ = 0;        // forecasts held
-  bool scored_ = false;     // last_scored_ is set
+  std::vector<double> surprise_ring_;  // per bucket `surprise_window` z^2, a ring each
+  std::vector<double> surprise_sum_;   // per bucket: the sum of its ring
+  std::vector<int> surprise_filled_;   // per bucket: entries in its ring
+  std::vector<double> rho_;            // per bucket: rho*_b, the prefix maximum
+  std::vector<Kept> kept_;             // a ring of the last `horizon` forecasts
+  size_t next_ = 0;                    // where the next forecast goes
+  size_t count_ = 0;                   // forecasts held
+  bool scored_ = false;                // last_scored_ is set
   int64_t last_scored_ = 0;
 };
 

@@ -49,6 +49,7 @@ void TrajectoryPredictor::reset() {
   started_ = false;
   have_seen_ = false;
   occluded_ = 0;
+  last_gap_ = since_gap_ = 0;
   gating_since_.reset();
   error_.reset();
 }
@@ -70,6 +71,8 @@ Forecast TrajectoryPredictor::emit_sample(int64_t grid, const Eigen::Vector3d& v
       }
       axes_[static_cast<size_t>(i)]->replace_newest(line);
     }
+    last_gap_ = occluded_;
+    since_gap_ = 0;
     occluded_ = 0;
   }
   for (int i = 0; i < 3; ++i) axes_[static_cast<size_t>(i)]->push(value[i], measured);
@@ -93,10 +96,13 @@ Forecast TrajectoryPredictor::emit_sample(int64_t grid, const Eigen::Vector3d& v
   std::array<std::vector<double>, 3> axis;
   for (int i = 0; i < 3; ++i)
     axis[static_cast<size_t>(i)] = axes_[static_cast<size_t>(i)]->forecast(params_.horizon);
+  // The samples the published sigma counts past a measurement (PredictorParams::after_gap).
+  const int unseen = occluded_ > 0 ? occluded_ : since_gap_ < params_.after_gap ? last_gap_ : 0;
+  if (measured && since_gap_ < params_.after_gap) ++since_gap_;
   for (int h = 0; h < params_.horizon; ++h) {
     f.positions.emplace_back(axis[0][static_cast<size_t>(h)], axis[1][static_cast<size_t>(h)],
                              axis[2][static_cast<size_t>(h)]);
-    f.sigma.push_back(error_.sigma(h + 1 + occluded_));
+    f.sigma.push_back(error_.sigma(h + 1 + unseen));
   }
   error_.record(grid, occluded_, f.positions, params_.period_us);
   return f;

@@ -42,6 +42,13 @@ struct PredictorParams {
   double reset_distance = 10.0;
   /// The predictor's estimate of its own error per horizon (forecast_error.hpp).
   ForecastErrorParams error;
+  /// Forecasts made on the first `after_gap` samples after an occlusion publish the sigma of a
+  /// forecast still inside it, sigma(h + gap length): their history's newest samples are the line
+  /// across the gap, not measurements, so the motion they continue is the gap's average, not the
+  /// ball's now (a drift reversal hidden by the gap). By then the samples after the gap have
+  /// been scored, and a turn among them widens the sigmas (ForecastError's surprise). They are
+  /// still scored at h, as made from a measurement. 0: the sigma of h at once.
+  int after_gap = 2;
 };
 
 /// One measurement of the ball (OBJECT_POSITION).
@@ -133,6 +140,8 @@ class TrajectoryPredictor {
   int64_t next_grid_ = 0;   // utime of the next grid sample to produce
   bool have_seen_ = false;
   int64_t seen_utime_ = 0;  // last visible measurement
+  int last_gap_ = 0;        // fed-back samples of the last occlusion ...
+  int since_gap_ = 0;       // ... and measured samples since it ended
   Eigen::Vector3d seen_position_ = Eigen::Vector3d::Zero();
   int64_t last_real_grid_ = 0;  // last grid sample made from measurements
   Eigen::Vector3d last_real_value_ = Eigen::Vector3d::Zero();

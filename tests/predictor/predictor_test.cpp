@@ -273,6 +273,31 @@ TEST(Predictor, ForecastsCarryTheirOwnErrorEstimate) {
   EXPECT_EQ(hidden[0].sigma[0], predictor.error().sigma(3));
 }
 
+// After an occlusion of g samples, the forecasts made on the first `after_gap` (2) measured
+// samples publish the sigma of a forecast still g samples inside it, sigma(h + g): their history's
+// newest samples are the line across the gap, not measurements. The third publishes sigma(h).
+TEST(Predictor, ForecastsJustAfterAGapCarryTheGapsSigma) {
+  PredictorParams p = params_4hz();
+  TrajectoryPredictor predictor(p);
+  ASSERT_EQ(p.after_gap, 2);
+  int64_t k = 0;
+  auto step = [&](bool visible) {
+    const double t = static_cast<double>(k) * 0.25;
+    return predictor.add({kT0 + k++ * 250'000, visible, circle(t)});
+  };
+  for (int i = 0; i < 400; ++i) step(true);
+  for (int i = 0; i < 5; ++i) step(false);
+  for (int after = 1; after <= 3; ++after) {
+    const auto f = step(true);
+    ASSERT_EQ(f.size(), 1u);
+    ASSERT_EQ(f[0].occluded_samples, 0);
+    const int unseen = after <= 2 ? 5 : 0;
+    for (int h : {1, 7, 16})
+      EXPECT_EQ(f[0].sigma[static_cast<size_t>(h - 1)], predictor.error().sigma(h + unseen))
+          << "sample " << after << " after the gap, h = " << h;
+  }
+}
+
 // 30 Hz measurements become samples every 0.25 s exactly, linearly interpolated on utime.
 TEST(Predictor, ResamplesIrregularInputOntoThePeriod) {
   PredictorParams p = params_4hz();
