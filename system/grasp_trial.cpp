@@ -15,8 +15,8 @@
 #include "sim/occlusion.hpp"
 #include "sim/stereo_rig.hpp"
 #include "stereograsp/grasp_command_t.hpp"
+#include "system/simulated_arm.hpp"
 #include "system/simulated_clock.hpp"
-#include "system/simulated_line.hpp"
 #include "vision/stereo_step.hpp"
 
 namespace sg::system {
@@ -64,7 +64,6 @@ class Trial {
  private:
   // ---- The world ----
   Eigen::Vector3d ball_at(double t) const;
-  sim::ArmState arm_state(double t) const;
   /// One stereo frame through the cameras and sg-vision: OBJECT_POSITION, or none without a
   /// calibration.
   point3_t see(int64_t index, double t);
@@ -76,8 +75,7 @@ class Trial {
   void grasp_loop(double t);                        // sg-grasp's loop
   void driver_loop(double t);                       // sg-arm-driver's loop
   void operator_command(int8_t command, double t);  // sg-grasp-ctl
-  void send_arm_command(arm_cmd_t command);          // sg-grasp's signed publish
-  void on_arm_command(const arm_cmd_t& command);     // sg-arm-driver's subscription
+  void send_arm_command(arm_cmd_t command);         // sg-grasp's signed publish
   template <class F>
   void deliver(F&& f) {
     clock_.at(clock_.now() + p_.bus_latency, std::forward<F>(f));
@@ -93,18 +91,13 @@ class Trial {
   std::unique_ptr<sim::CameraSimulator> camera_;
   sim::StereoFrame frame_;
   std::mt19937_64 noise_rng_;
-  sim::C550Controller controller_;
-  sim::C550Emulator emulator_;
-  SimulatedLine line_;
-  arm::ArmDriver driver_;
+  auth::LabKey key_ = trial_key();
+  SimulatedArm arm_;  // the C550 on its line, sg-arm-driver's core
   vision::StereoStep vision_;
   predictor::TrajectoryPredictor predictor_;
   grasp::GraspNode node_;
-  auth::LabKey key_ = trial_key();
   auth::CommandSigner grasp_signer_{key_, "sg-grasp@trial:1", clock_};
   auth::CommandSigner operator_signer_{key_, "sg-grasp-ctl@trial:2", clock_};
-  auth::CommandVerifier driver_verifier_{key_};
-  ChangeOrPeriod arm_status_rule_;
   std::stop_source stop_;
 
   int64_t operator_sequence_ = 0;
@@ -117,12 +110,19 @@ class Trial {
   TrialResult result_;
 };
 
-vision::StereoCalibration true_calibration(const std::array<vision::CameraModel, 2>& cameras) {
+/// The cameras sg-vision triangulates with: the trial's calibration, or the simulator's own.
+vision::StereoCalibration vision_calibration(const TrialParams& p,
+                                             const std::array<vision::CameraModel, 2>& cameras) {
+  if (p.calibration) return *p.calibration;
   vision::StereoCalibration c;
   c.left = cameras[0];
   c.right = cameras[1];
   c.source = "grasp trial: the simulator's true cameras";
   return c;
+}
+
+SimulatedArmParams arm_params(const TrialParams& p) {
+  return {p.arm, p.c550, p.driver, p.baud, p.arm_status_rate};
 }
 
 Trial::Trial(const TrialParams& p)
@@ -131,36 +131,22 @@ Trial::Trial(const TrialParams& p)
       scenario_(sim::make_scenario(p.sim.scenario)),
       cameras_(sim::make_rig(p.sim.rig)),
       noise_rng_(p.seed * 0x9E3779B97F4A7C15ULL + 17),
-      controller_(p.arm, p.c550),
-      emulator_(controller_, p.driver.slave),
-      line_(emulator_, clock_,
-            {p.baud, [this](double t) { emulator_.set_ball_centre(ball_at(t)); }}),
-      driver_(p.arm, p.driver, [this] { return line_.connect(); }, clock_),
-      vision_(p.tracker, cv::Size(p.sim.rig.width, p.sim.rig.height), true_calibration(cameras_),
+      arm_(arm_params(p), clock_, key_, [this](double t) { return ball_at(t); }),
+      vision_(p.tracker, cv::Size(p.sim.rig.width, p.sim.rig.height),
+              vision_calibration(p, cameras_),
               vision::StereoMatchParams{.ball_radius = p.sim.ball_radius}),
       predictor_(p.predictor),
-      node_(p.arm, p.grasp, kTrialEpochUtime, 1.0 / p.grasp_status_rate),
-      arm_status_rule_(1.0 / p.arm_status_rate) {
+      node_(p.arm, p.grasp, kTrialEpochUtime, 1.0 / p.grasp_status_rate) {
   p_.sim.frame_rate = p.frame_rate;
   node_.require_signed_commands(key_, "GRASP_COMMAND");
   if (p_.render) camera_ = std::make_unique<sim::CameraSimulator>(p_.sim);
 }
 
 Eigen::Vector3d Trial::ball_at(double t) const {
-  if (controller_.holding()) return controller_.tool_pose(t).translation();
-  if (controller_.released_at()) return *controller_.released_at();  // stays where let go
+  const sim::C550Controller& c = arm_.controller();
+  if (c.holding()) return c.tool_pose(t).translation();
+  if (c.released_at()) return *c.released_at();  // stays where let go
   return scenario_->position(t);
-}
-
-sim::ArmState Trial::arm_state(double t) const {
-  sim::ArmState a;
-  a.present = true;
-  const Eigen::Isometry3d tool = controller_.tool_pose(t);
-  a.tool_position = tool.translation();
-  a.tool_rpy = arm::rpy_from_rotation(tool.rotation());
-  a.gripper_opening = controller_.gripper_opening(t);
-  a.holding_object = controller_.holding();
-  return a;
 }
 
 point3_t Trial::model_camera(double t, const Eigen::Vector3d& truth) {
@@ -179,7 +165,7 @@ point3_t Trial::model_camera(double t, const Eigen::Vector3d& truth) {
 
 point3_t Trial::see(int64_t index, double t) {
   if (!camera_) return model_camera(t, ball_at(t));
-  camera_->render(index, arm_state(t), frame_);
+  camera_->render(index, arm_.state(t), frame_);
   return *vision_.process(frame_.image[0], frame_.image[1], index, clock_.utime_at(t)).position;
 }
 
@@ -190,8 +176,8 @@ void Trial::capture(int64_t index, double t) {
   const Eigen::Vector3d seen_truth = camera_ ? frame_.ball : truth;
   if (position.visible) {
     ++result_.visible;
-    if (controller_.closes().empty()) last_seen_ = t;  // the last sighting before the CLOSE
-    if (!controller_.holding()) {
+    if (arm_.controller().closes().empty()) last_seen_ = t;  // the last sighting before the CLOSE
+    if (!arm_.controller().holding()) {
       const Eigen::Vector3d m(position.position[0], position.position[1], position.position[2]);
       vision_sq_ += (m - seen_truth).squaredNorm();
       ++vision_n_;
@@ -221,22 +207,13 @@ void Trial::grasp_loop(double) {
 
 void Trial::send_arm_command(arm_cmd_t command) {
   grasp_signer_.sign("ARM_COMMAND", command);
-  deliver([this, m = over_bus(command)](double) { on_arm_command(m); });
-}
-
-void Trial::on_arm_command(const arm_cmd_t& command) {
-  const auth::Verification v = driver_verifier_.verify("ARM_COMMAND", command, clock_.utime());
-  if (v.accepted()) {
-    driver_.submit(command);
-  } else {
-    driver_.refuse(command, "unauthenticated: " + v.reason);
-  }
+  deliver([this, m = over_bus(command)](double) { arm_.on_arm_command(m); });
 }
 
 void Trial::driver_loop(double t) {
-  auto [status, version] = driver_.status();
-  if (!arm_status_rule_.due(version, t)) return;
-  status.utime = clock_.utime();
+  std::optional<stereograsp::arm_status_t> due = arm_.status_due(t);
+  if (!due) return;
+  const stereograsp::arm_status_t& status = *due;
   if (status.last_rejected_sequence != last_rejected_) {
     last_rejected_ = status.last_rejected_sequence;
     ++result_.rejected;
@@ -275,16 +252,16 @@ TrialResult Trial::run() {
   });
   clock_.every(kDriverLoopPeriod, [this](double t) { driver_loop(t); });
   operator_command(stereograsp::grasp_command_t::COMMAND_TRACK, 0.0);
-  clock_.at(p_.grasp_time, [this](double t) {
-    operator_command(stereograsp::grasp_command_t::COMMAND_GRASP, t);
-  });
+  clock_.at(p_.grasp_time,
+            [this](double t) { operator_command(stereograsp::grasp_command_t::COMMAND_GRASP, t); });
   clock_.at(p_.grasp_time + p_.timeout, [this](double) { stop_.request_stop(); });
-  driver_.run(stop_.get_token());  // every wait of the driver runs the world
+  arm_.run(stop_.get_token());  // every wait of the driver runs the world
   return finish();
 }
 
 void Trial::record_close() {
-  const auto& closes = controller_.closes();
+  const sim::C550Controller& controller = arm_.controller();
+  const auto& closes = controller.closes();
   if (closes.empty()) return;
   const sim::C550Controller::CloseRecord& c = closes.front();
   const Eigen::Vector3d ball = c.ball.value_or(Eigen::Vector3d::Constant(std::nan("")));
@@ -299,8 +276,8 @@ void Trial::record_close() {
     if (close_command_->target_utime != 0)
       result_.timing_error = c.t - clock_.time_of(close_command_->target_utime);
   }
-  const double rise = controller_.tool_pose(clock_.now()).translation().z() - c.tcp.z();
-  result_.lifted = controller_.holding() && rise >= 0.5 * p_.grasp.lift;
+  const double rise = controller.tool_pose(clock_.now()).translation().z() - c.tcp.z();
+  result_.lifted = controller.holding() && rise >= 0.5 * p_.grasp.lift;
 }
 
 TrialResult Trial::finish() {
@@ -310,15 +287,15 @@ TrialResult Trial::finish() {
   result_.outcome = s.outcome;
   result_.final_state = s.state;
   result_.message = s.message;
-  result_.success = controller_.holding() && result_.lifted;
+  result_.success = arm_.controller().holding() && result_.lifted;
   result_.machine_success = s.outcome == grasp::GraspOutcome::kSuccess;
   result_.machine_agrees = result_.machine_success == result_.success;
-  for (const std::string& line : emulator_.executed_commands()) {
+  for (const std::string& line : arm_.emulator().executed_commands()) {
     const std::string verb = line.substr(0, line.find(' '));
     if (verb == "MA" || verb == "READY" || verb == "OPEN" || verb == "CLOSE" || verb == "ABORT")
       ++result_.interactions;
   }
-  result_.serial_bytes = line_.bytes_written();
+  result_.serial_bytes = arm_.line().bytes_written();
   if (vision_n_ > 0) result_.vision_rms = std::sqrt(vision_sq_ / vision_n_);
   result_.vision_samples = static_cast<int64_t>(vision_n_);
   return result_;

@@ -29,6 +29,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "arm_driver/arm_driver.hpp"
@@ -37,6 +38,7 @@
 #include "sim/c550_controller.hpp"
 #include "sim/camera_simulator.hpp"
 #include "vision/blob_tracker.hpp"
+#include "vision/calibration_file.hpp"
 
 namespace sg::system {
 
@@ -45,23 +47,26 @@ inline constexpr int64_t kTrialEpochUtime = 1'700'000'000'000'000;
 
 /// Everything a trial depends on. paper_trial() fills it for the paper's scenario.
 struct TrialParams {
-  uint64_t seed = 1;           ///< seeds the camera noise, the C550 delays and the pixel noise
-  sim::SimParams sim;          ///< rig, scenario, occlusion episodes, lighting, noise
-  bool render = true;          ///< false: no images; the camera model above
-  double frame_rate = 4.0;     ///< Hz: stereo frames
-  double pixel_sigma = 0.25;   ///< px per axis, !render (rendered vision measured ~0.7 mm 3D RMS)
+  uint64_t seed = 1;          ///< seeds the camera noise, the C550 delays and the pixel noise
+  sim::SimParams sim;         ///< rig, scenario, occlusion episodes, lighting, noise
+  bool render = true;         ///< false: no images; the camera model above
+  double frame_rate = 4.0;    ///< Hz: stereo frames
+  double pixel_sigma = 0.25;  ///< px per axis, !render (rendered vision measured ~0.7 mm 3D RMS)
   vision::BlobTracker::Params tracker;
+  /// The cameras sg-vision triangulates with (e.g. calibration_trial.hpp's robot-guided one);
+  /// unset: the simulator's true cameras.
+  std::optional<vision::StereoCalibration> calibration;
   predictor::PredictorParams predictor;
   arm::ArmGeometry arm = arm::ArmGeometry::a465();
   sim::C550Params c550;
-  arm::DriverSettings driver;  ///< sg-arm-driver's settings (timing, polls, retries)
-  int baud = 38400;            ///< the serial line
-  grasp::GraspSettings grasp;  ///< use_prediction = false is the --no-prediction baseline
-  double arm_status_rate = 20.0;    ///< Hz: sg-arm-driver's ARM_STATUS at rest
-  double grasp_status_rate = 4.0;   ///< Hz: sg-grasp's GRASP_STATUS at rest
-  double bus_latency = 0.001;  ///< s: a message reaches its subscribers this much later
-  double grasp_time = 45.0;    ///< s: the grasp command (track is commanded at 0)
-  double timeout = 15.0;       ///< s after the grasp command: the trial ends without an outcome
+  arm::DriverSettings driver;      ///< sg-arm-driver's settings (timing, polls, retries)
+  int baud = 38400;                ///< the serial line
+  grasp::GraspSettings grasp;      ///< use_prediction = false is the --no-prediction baseline
+  double arm_status_rate = 20.0;   ///< Hz: sg-arm-driver's ARM_STATUS at rest
+  double grasp_status_rate = 4.0;  ///< Hz: sg-grasp's GRASP_STATUS at rest
+  double bus_latency = 0.001;      ///< s: a message reaches its subscribers this much later
+  double grasp_time = 45.0;        ///< s: the grasp command (track is commanded at 0)
+  double timeout = 15.0;           ///< s after the grasp command: the trial ends without an outcome
   double settle_after_outcome = 0.0;  ///< s the trial runs on after the machine's outcome
 };
 
