@@ -411,11 +411,15 @@ void md_prediction_by_phase(std::ostream& o, const std::vector<PhasePrediction>&
        "time in another.\n\n| phase | time s | h | vs measurement: n, RMS, p95, max | vs truth: "
        "n, RMS, p95, max |\n|---|---:|---:|---|---|\n";
   for (const PhasePrediction& p : phases) {
+    bool any = false;
     for (const PhaseHorizon& h : p.horizons) {
       if (h.vs_measurement.count == 0 && h.vs_truth.count == 0) continue;
+      any = true;
       o << "| " << p.phase << " | " << num(p.duration_s, 1) << " | " << h.h << " | "
         << mm_cell(h.vs_measurement) << " | " << mm_cell(h.vs_truth) << " |\n";
     }
+    if (!any && p.duration_s > 0)  // a phase with no prediction scored: its time alone
+      o << "| " << p.phase << " | " << num(p.duration_s, 1) << " | – | – | – |\n";
   }
 }
 

@@ -9,11 +9,13 @@
 
 #include <cmath>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "common/message_types.hpp"
+#include "logger/report.hpp"
 #include "logger/session_stats.hpp"
 
 namespace sg::logger {
@@ -322,6 +324,30 @@ TEST_F(PhaseErrorTest, OverallFiguresAndTimeInEachPhase) {
   EXPECT_NEAR(row(s(), "carried").duration_s, 45.002 - 33.125, 1e-9);  // the last event: 45.002 s
   EXPECT_NEAR(row(s(), "no_grasp_machine").duration_s, 0, 1e-9);
   EXPECT_TRUE(std::isnan(row(s(), "coasting").duration_s));
+}
+
+// report.json names each phase by its key with the errors in metres (the overall "prediction"
+// stays); report.md has a row per phase and horizon in millimetres, none for a phase never
+// entered; the console summary gives the tracking phase.
+TEST_F(PhaseErrorTest, InTheReports) {
+  const nlohmann::json j = nlohmann::json::parse(report_json(s()));
+  ASSERT_TRUE(j.contains("prediction"));
+  const nlohmann::json& phases = j.at("prediction_by_phase");
+  ASSERT_EQ(phases.size(), 8u);
+  EXPECT_EQ(phases[3].at("phase"), "tracking");
+  EXPECT_NEAR(phases[3].at("duration_s").get<double>(), 20, 1e-9);
+  EXPECT_NEAR(phases[3]["horizons"][0]["vs_truth_m"]["rms"].get<double>(), 0.001, 1e-9);
+  EXPECT_EQ(phases[3]["horizons"][0]["vs_measurement_m"]["count"].get<int>(), 75);
+  EXPECT_TRUE(phases[7].at("duration_s").is_null());  // across phases: no time of its own
+  const std::string md = report_markdown(s());
+  EXPECT_NE(md.find("| tracking | 20.0 | 1 | 75, 1.00, 1.00, 1.00 | 75, 1.00, 1.00, 1.00 |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| calibration | 10.1 | 16 | "), std::string::npos);
+  EXPECT_EQ(md.find("| no grasp machine |"), std::string::npos);
+  EXPECT_NE(summary_text(s()).find(
+                "prediction h=1 while tracking: RMS 1.00 mm vs measurement, 1.00 mm vs truth"),
+            std::string::npos);
 }
 
 // Figure 5 leaves out the ball the arm holds: the spans of the calibration and the carried ball.
