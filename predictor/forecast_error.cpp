@@ -29,10 +29,10 @@ ForecastError::ForecastError(int horizon, int max_gap, const ForecastErrorParams
   filled_.assign(n, 1);
   head_.assign(n, 1 % p.window);
   scores_.assign(n, 0);
-  surprise_ring_.assign(n * static_cast<size_t>(p.surprise_window), 0.0);
-  surprise_sum_.assign(n, 0.0);
+  surprise_ring_.assign(n * static_cast<size_t>(p.surprise_window), Surprise{});
+  surprise_sum_.assign(n, Surprise{});
   surprise_filled_.assign(n, 0);
-  rho_.assign(n, 1.0);
+  turn_.assign(n, Eigen::Vector3d::Zero());
   for (size_t b = 0; b < n; ++b) {  // the prior is each window's first entry
     const double s = p.prior_sigma * static_cast<double>(b + 1);
     window_[b * w] = sum_[b] = Eigen::Vector3d::Constant(s * s);
@@ -110,38 +110,45 @@ void ForecastError::score(int64_t utime, const Eigen::Vector3d& sample,
     const Eigen::Vector3d e = sample - k.positions[static_cast<size_t>(h - 1)];
     if (!(e.cwiseAbs().maxCoeff() <= 1e6)) continue;  // NaN too
     const size_t b = bucket(h + k.occluded);
-    const Eigen::Vector3d s = estimate(b);
-    add_surprise(b, (e.cwiseAbs2().array() / (s.cwiseAbs2() + noise).array()).mean());
+    const Eigen::Vector3d expected = estimate(b).cwiseAbs2() + noise;
+    add_surprise(b, {(e.cwiseAbs2().array() / expected.array()).mean(), e.cwiseAbs2() - expected});
     add(b, e.cwiseAbs2(), noise);
     ++scores_[b];
   }
-  update_surprise();
+  update_turn();
 }
 
-void ForecastError::add_surprise(size_t b, double z2) {
+void ForecastError::add_surprise(size_t b, Surprise s) {
   const int w = params_.surprise_window;
-  if (w == 0 || !std::isfinite(z2)) return;
+  if (w == 0 || !std::isfinite(s.z2) || !s.excess.allFinite()) return;
+  s.z2 = std::min(s.z2, 1e12);
+  s.excess = s.excess.cwiseMin(1e12);
   // The ring's slot: scores_ counts every score, so it cycles through the window.
-  double& slot = surprise_ring_[b * static_cast<size_t>(w) + static_cast<size_t>(scores_[b] % w)];
-  if (surprise_filled_[b] == w) surprise_sum_[b] -= slot;
-  slot = std::min(z2, 1e12);
-  surprise_sum_[b] += slot;
+  Surprise& slot = surprise_ring_[b * static_cast<size_t>(w) + static_cast<size_t>(scores_[b] % w)];
+  Surprise& sum = surprise_sum_[b];
+  if (surprise_filled_[b] == w) sum.z2 -= slot.z2, sum.excess -= slot.excess;
+  slot = s;
+  sum.z2 += s.z2, sum.excess += s.excess;
   surprise_filled_[b] = std::min(surprise_filled_[b] + 1, w);
   if (scores_[b] % w == w - 1) {  // once a round, the sum afresh (no rounding drift)
-    surprise_sum_[b] = 0;
-    const double* ring = &surprise_ring_[b * static_cast<size_t>(w)];
-    for (int i = 0; i < surprise_filled_[b]; ++i) surprise_sum_[b] += ring[i];
+    sum = Surprise{};
+    const Surprise* ring = &surprise_ring_[b * static_cast<size_t>(w)];
+    for (int i = 0; i < surprise_filled_[b]; ++i)
+      sum.z2 += ring[i].z2, sum.excess += ring[i].excess;
   }
 }
 
-void ForecastError::update_surprise() {
-  double rho = 1.0;
-  for (size_t b = 0; b < rho_.size(); ++b) {
-    if (surprise_filled_[b] > 0) {
-      const double mean = surprise_sum_[b] / surprise_filled_[b];
-      rho = std::max(rho, std::sqrt(std::max(0.0, mean) / params_.surprise_threshold));
+void ForecastError::update_turn() {
+  // T_b = b max over surprised b' <= b of eps_b' / b': a prefix maximum, O(buckets).
+  Eigen::Vector3d per_sample = Eigen::Vector3d::Zero();
+  for (size_t b = 0; b < turn_.size(); ++b) {
+    const int m = surprise_filled_[b];
+    const double horizon = static_cast<double>(b + 1);
+    if (m > 0 && surprise_sum_[b].z2 / m > params_.surprise_threshold) {
+      const Eigen::Vector3d eps = (surprise_sum_[b].excess / m).cwiseMax(0).cwiseSqrt();
+      per_sample = per_sample.cwiseMax(eps / horizon);
     }
-    rho_[b] = rho;
+    turn_[b] = horizon * per_sample;
   }
 }
 
@@ -159,10 +166,11 @@ Eigen::Vector3d ForecastError::estimate(size_t b) const {
 Eigen::Vector3d ForecastError::sigma(int samples) const {
   const size_t b = bucket(samples);
   const double widen = params_.predictive ? predictive_factor(filled_[b]) : 1.0;
-  return widen * rho_[b] * estimate(b);
+  const Eigen::Vector3d s = widen * estimate(b);
+  return (s.cwiseAbs2() + turn_[b].cwiseAbs2()).cwiseSqrt();
 }
 
-double ForecastError::surprise(int samples) const { return rho_[bucket(samples)]; }
+Eigen::Vector3d ForecastError::turn(int samples) const { return turn_[bucket(samples)]; }
 
 int64_t ForecastError::scores(int samples) const { return scores_[bucket(samples)]; }
 

@@ -28,17 +28,23 @@
 /// A turn seen widens every longer horizon at once (issue 17). The window above hears of a change
 /// of motion (the drift's reversal) at horizon b only b samples after it, when the forecasts made
 /// before it come due; a grasp planned on sigma(7) in between closes on an old certainty. So each
-/// bucket also keeps its last `surprise_window` normalized squared errors
+/// bucket also keeps its last `surprise_window` scores' normalized squared error and excess,
 ///
-///     z^2 = (1/3) sum over the axes of e_i^2 / (s_b,i^2 + r_i^2),   (s_b from before the score)
+///     z^2 = (1/3) sum over the axes of e_i^2 / (s_b,i^2 + r_i^2),   x_i = e_i^2 - s_b,i^2 - r_i^2
 ///
-/// whose mean is 1 for a calibrated estimate, and its surprise rho_b = sqrt(mean z^2 / c), at
-/// least 1 (c = surprise_threshold, so chance alone seldom widens). sigma(b) is multiplied by
+/// (s_b from before the score). The mean z^2 is 1 for a calibrated estimate; above
+/// `surprise_threshold` c the bucket is surprised, and its excess eps_b = sqrt(max(mean x, 0))
+/// per axis is a change of motion the forecasts did not know. A change of velocity dv shows at
+/// horizon b' as an error dv b' T and at a longer horizon b as dv b T: (b / b') times as much,
+/// while the model still forecasts the old motion. So the turn term
 ///
-///     rho*_b = max over b' <= b of rho_b',
+///     T_b = b max over surprised b' <= b of eps_b' / b'
 ///
-/// so a large h = 1 error, seen one sample after the turn, widens h = 1 .. H + max_gap, and the
-/// widening lasts as long as any shorter horizon is still surprised (docs/prediction.md).
+/// is added in quadrature, sigma(b) = sqrt((w s_b)^2 + T_b^2) per axis (w the predictive
+/// factor): a large h = 1 error, seen one sample after the turn, widens h = 1 .. H + max_gap at
+/// once; as the turn reaches the longer horizons' own scores (b' = 2, 3, ... in turn) they carry
+/// it on, until their windows hold it. A mean of `surprise_window` z^2 over c by chance (about 1
+/// in 8 for 4 scores and c = 1.5) adds about b 0.7 s_b' (docs/prediction.md).
 /// The estimates survive
 /// reset() (they describe the predictor on this motion, not one track); the kept forecasts do not
 /// (their grid is gone).
@@ -64,9 +70,9 @@ struct ForecastErrorParams {
   /// sigma() widened by predictive_factor(m): 2 sigma then bounds the next error as often as a
   /// normal's 2 sigma does, although s is estimated from m scores (Student's t). false: s itself.
   bool predictive = true;
-  /// Scores a bucket's surprise averages (0: no widening on surprise; at most 64).
+  /// Scores a bucket's surprise averages (0: no turn term; at most 64).
   int surprise_window = 4;
-  /// Mean z^2 above which a bucket is surprised (rho = sqrt(mean / this)).
+  /// Mean z^2 above which a bucket is surprised (its excess then counts in the turn term).
   double surprise_threshold = 1.5;
 };
 
@@ -100,8 +106,8 @@ class ForecastError {
   /// 1-sigma error per axis (m) of a point `samples` grid samples past the last measurement
   /// (1 .. horizon + max_gap; clamped into that range).
   Eigen::Vector3d sigma(int samples) const;
-  /// rho*_b: the surprise factor sigma(samples) includes (1 when nothing surprised).
-  double surprise(int samples) const;
+  /// T_b: the turn term sigma(samples) includes per axis (m; zero when nothing surprised).
+  Eigen::Vector3d turn(int samples) const;
   /// Scores the estimate of that horizon has had (0 .. ; the prior not counted).
   int64_t scores(int samples) const;
   /// t_{m-1}(0.97725) sqrt(1 + 1/m) / 2, at most 2: how much wider than 2 s a 2-sigma interval
@@ -120,12 +126,17 @@ class ForecastError {
   size_t bucket(int samples) const;
   /// Adds e^2 and r^2 to bucket b's window, dropping its oldest entry when it is full.
   void add(size_t b, const Eigen::Vector3d& value, const Eigen::Vector3d& noise);
-  /// sigma(b) without the predictive factor or the surprise: s_b.
+  /// One score's surprise: z^2 and the excess x per axis.
+  struct Surprise {
+    double z2 = 0;
+    Eigen::Vector3d excess = Eigen::Vector3d::Zero();
+  };
+  /// sigma(b) without the predictive factor or the turn: s_b.
   Eigen::Vector3d estimate(size_t b) const;
-  /// Adds z^2 to bucket b's surprise ring.
-  void add_surprise(size_t b, double z2);
-  /// rho*_b afresh for every bucket (after a sample's scores).
-  void update_surprise();
+  /// Adds a score's surprise to bucket b's ring.
+  void add_surprise(size_t b, Surprise s);
+  /// T_b afresh for every bucket (after a sample's scores).
+  void update_turn();
 
   int horizon_;
   ForecastErrorParams params_;
@@ -136,14 +147,14 @@ class ForecastError {
   std::vector<int> filled_;                 // per bucket: entries in its ring (the prior the first)
   std::vector<int> head_;                   // per bucket: where its next entry goes
   std::vector<int64_t> scores_;
-  std::vector<double> surprise_ring_;  // per bucket `surprise_window` z^2, a ring each
-  std::vector<double> surprise_sum_;   // per bucket: the sum of its ring
-  std::vector<int> surprise_filled_;   // per bucket: entries in its ring
-  std::vector<double> rho_;            // per bucket: rho*_b, the prefix maximum
-  std::vector<Kept> kept_;             // a ring of the last `horizon` forecasts
-  size_t next_ = 0;                    // where the next forecast goes
-  size_t count_ = 0;                   // forecasts held
-  bool scored_ = false;                // last_scored_ is set
+  std::vector<Surprise> surprise_ring_;  // per bucket `surprise_window` scores, a ring each
+  std::vector<Surprise> surprise_sum_;   // per bucket: the sum of its ring
+  std::vector<int> surprise_filled_;     // per bucket: entries in its ring
+  std::vector<Eigen::Vector3d> turn_;    // per bucket: T_b
+  std::vector<Kept> kept_;               // a ring of the last `horizon` forecasts
+  size_t next_ = 0;                      // where the next forecast goes
+  size_t count_ = 0;                     // forecasts held
+  bool scored_ = false;                  // last_scored_ is set
   int64_t last_scored_ = 0;
 };
 

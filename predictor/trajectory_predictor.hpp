@@ -46,7 +46,7 @@ struct PredictorParams {
   /// forecast still inside it, sigma(h + gap length): their history's newest samples are the line
   /// across the gap, not measurements, so the motion they continue is the gap's average, not the
   /// ball's now (a drift reversal hidden by the gap). By then the samples after the gap have
-  /// been scored, and a turn among them widens the sigmas (ForecastError's surprise). They are
+  /// been scored, and a turn among them widens the sigmas (ForecastError's turn term). They are
   /// still scored at h, as made from a measurement. 0: the sigma of h at once.
   int after_gap = 2;
 };

@@ -152,11 +152,12 @@ TEST(ForecastError, PredictiveWideningIsStudentsT) {
               1e-15);
 }
 
-// A turn seen: one h = 1 error of (-60, 20, 0) mm where the model expects (10, 20, 0) mm widens
+// A turn seen: one h = 1 error of (-60, 20, 0) mm where the model expects (-10, 20, 0) mm widens
 // every horizon at once, long before the longer horizons' own forecasts come due. Its
-// z^2 = (36 + 1 + 0) / 3 and the three before it (1 + 1 + 0) / 3 average 3.5833 over the window
-// of 4: rho = sqrt(3.5833 / 1.5) = 1.5456 on h = 1 .. 20 (the prefix maximum), and the sigma
-// is the plain estimate times it. Four ordinary scores later nothing is surprised.
+// z^2 = (36 + 1 + 0) / 3 and the three before it (1 + 1 + 0) / 3 average 3.58 over the window
+// of 4, above 1.5: surprised, with an excess in x of (3600 - 100) / 4 mm^2, eps = 29.58 mm. The
+// turn term is then b eps on every horizon b (the prefix maximum), in quadrature with the plain
+// estimate. Four ordinary scores later nothing is surprised and the term is gone.
 TEST(ForecastError, ALargeShortErrorWidensEveryLongerHorizonAtOnce) {
   ForecastError model(kH, 4, {.predictive = false});
   const Eigen::Vector3d usual(0.010, -0.020, 0), turn(0.060, -0.020, 0);
@@ -169,25 +170,30 @@ TEST(ForecastError, ALargeShortErrorWidensEveryLongerHorizonAtOnce) {
     model.record(t, 0, f, kPeriod);
   };
   for (int k = 0; k < 2000; ++k) step(k, false);
-  for (int h : {1, 7, 16, 20}) EXPECT_EQ(model.surprise(h), 1.0) << h;
+  for (int h : {1, 7, 16, 20}) EXPECT_EQ(model.turn(h), Eigen::Vector3d::Zero()) << h;
   const Eigen::Vector3d sigma7 = model.sigma(7);
   step(2000, true);   // its h = 1 forecast is off by the turn ...
   step(2001, false);  // ... and scored here
-  const double rho = std::sqrt((37.0 / 3 + 3 * 2.0 / 3) / 4 / 1.5);
-  for (int h : {1, 2, 7, 16, 20}) EXPECT_NEAR(model.surprise(h), rho, 1e-9) << h;
-  EXPECT_NEAR(model.sigma(7).x(), rho * sigma7.x(), 1e-9) << "h = 7 has not heard of it itself";
-  EXPECT_NEAR(model.sigma(7).y(), rho * sigma7.y(), 1e-9);
+  const double eps = std::sqrt((0.060 * 0.060 - 0.010 * 0.010) / 4);
+  for (int h : {1, 2, 7, 16, 20}) {
+    EXPECT_NEAR(model.turn(h).x(), h * eps, 1e-9) << h;
+    EXPECT_EQ(model.turn(h).y(), 0.0) << h;
+    EXPECT_EQ(model.turn(h).z(), 0.0) << h;
+  }
+  EXPECT_NEAR(model.sigma(7).x(), std::hypot(sigma7.x(), 7 * eps), 1e-9)
+      << "h = 7 itself: as before";
+  EXPECT_NEAR(model.sigma(7).y(), sigma7.y(), 1e-9);
   for (int k = 2002; k < 2006; ++k) step(k, false);
-  for (int h : {1, 7, 20}) EXPECT_EQ(model.surprise(h), 1.0) << h;
+  for (int h : {1, 7, 20}) EXPECT_EQ(model.turn(h), Eigen::Vector3d::Zero()) << h;
 }
 
-// A surprise window of 0 never widens; a window beyond 64 or a threshold that is not positive
-// is refused.
+// A surprise window of 0 never adds a turn term; a window beyond 64 or a threshold that is not
+// positive is refused.
 TEST(ForecastError, SurpriseSettings) {
   ForecastError off(kH, 4, {.predictive = false, .surprise_window = 0});
   run(off, 200, 0,
       [](int k, int h) { return Eigen::Vector3d::Constant(k % 50 == 0 && h == 1 ? 0.5 : 0.001); });
-  EXPECT_EQ(off.surprise(1), 1.0);
+  EXPECT_EQ(off.turn(1), Eigen::Vector3d::Zero());
   EXPECT_THROW(ForecastError(kH, 4, {.surprise_window = 65}), std::invalid_argument);
   EXPECT_THROW(ForecastError(kH, 4, {.surprise_threshold = 0}), std::invalid_argument);
   EXPECT_THROW(ForecastError(kH, 4, {.surprise_threshold = NAN}), std::invalid_argument);
