@@ -44,11 +44,17 @@
 # shellcheck disable=SC2015  # `A && B || die`: B is a test, never a failing command
 # shellcheck disable=SC2154  # each grasp's variables come from its params.sh
 set -euo pipefail
-cd "$(dirname "$0")/.."
+self=$(realpath "$0")
+cd "$(dirname "$self")/.."
 
 me=live_grasps
 die() { echo "$me: $*" >&2; exit 1; }
 usage_error() { echo "$me: $* (see --help)" >&2; exit 2; }
+# The comment at the top, without its '#'.
+help() {
+  awk '/^# shellcheck/ { exit } NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' \
+    "$self"
+}
 
 # ---- options ---------------------------------------------------------------------------------
 grasps=20
@@ -91,8 +97,7 @@ parse_options() {
       --no-record) record=0 ;;
       --build-dir) build_dir="$2"; shift ;;
       --inside) inside="$2"; shift; shift; inside_args=("$@"); return ;;
-      -h|--help) awk '/^# shellcheck/ { exit } NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"
-                 exit 0 ;;
+      -h|--help) help; exit 0 ;;
       *) usage_error "unknown option '$1'" ;;
     esac
     shift
@@ -115,7 +120,8 @@ check_options() {
   case "$report" in failed|all|none) ;; *) usage_error "--report '$report': failed, all or none" ;;
   esac
   [ -z "$calibration" ] || [ -s "$calibration" ] || die "--calibration $calibration: no such file"
-  [ -z "$coefficients" ] || [ -s "$coefficients" ] || die "--coefficients $coefficients: no such file"
+  [ -z "$coefficients" ] || [ -s "$coefficients" ] ||
+    die "--coefficients $coefficients: no such file"
   return 0
 }
 
@@ -126,7 +132,7 @@ elapsed() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.0f", b - a }'; }
 # Sleeps until the epoch time $1 (at once if it is past).
 sleep_until() {
   local left
-  left=$(awk -v t="$1" -v n="$(now)" 'BEGIN { d = t - n; printf "%.3f", d > 0 ? d : 0 }')
+  left=$(awk -v t="$1" -v n="$(now)" 'BEGIN { d = t - n; printf "%.3f", (d > 0 ? d : 0) }')
   sleep "$left"
 }
 
@@ -340,22 +346,30 @@ judge_grasp() {
     miss=$(echo "$close" | sed -n 's/.*centre \([0-9.]*\) mm away.*/\1/p')
     [ -n "$miss" ] || miss="-"
     case "$close" in *": held"*) held=yes ;; esac
-    # The CLOSE's time (c550.tsv: utime, t, command) against the grasp command.
-    local close_utime asked
-    close_utime=$(awk -F'\t' '$3 ~ /^CLOSE/ { u = $1 } END { print u }' "$dir/c550.tsv" 2>/dev/null)
+    # When the CLOSE executed (sg-c550-sim's log line, local time; c550.tsv has when it was
+    # received, one controller delay earlier) after the grasp command.
+    local close_time asked
+    close_time=$(grep 'CLOSE at' "$dir/c550.txt" | tail -1 | cut -d' ' -f1,2)
+    close_time=$(date -d "$close_time" +%s.%N 2>/dev/null || true)
     asked=$(sed -n 's/^grasp asked at \([0-9.]*\).*/\1/p' "$dir/ctl.txt")
-    [ -n "$close_utime" ] && [ -n "$asked" ] &&
-      after=$(awk -v c="$close_utime" -v a="$asked" 'BEGIN { printf "%.1f", c / 1e6 - a }')
+    [ -n "$close_time" ] && [ -n "$asked" ] &&
+      after=$(awk -v c="$close_time" -v a="$asked" 'BEGIN { printf "%.1f", c - a }')
   else
     note="no CLOSE"
   fi
-  # Held after the lift too (the in-process trials' truth): the last SIM_ARM_STATE.
+  # Held after the lift too, as the in-process trials judge it: the last SIM_ARM_STATE holds the
+  # ball with the tool at least half the lift (0.15 m) above the CLOSE.
   if [ "$held" = yes ] && [ -s "$dir/session.lcmlog" ]; then
-    local last
+    local close_z last
+    close_z=$(echo "$close" | sed -n 's/^CLOSE at ([^,]*, [^,]*, \([-0-9.]*\)).*/\1/p')
     last=$("$bin/sg-report" export "$dir/session.lcmlog" --channel SIM_ARM_STATE --csv 2>/dev/null |
-      awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i; next }
-               { h = $c["holding_object"] } END { print h }' || true)
-    if [ "$last" = 0 ]; then held=no; note="${note:+$note; }dropped after the CLOSE"; fi
+      awk -F, -v z="${close_z:-0}" 'NR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i; next }
+        { h = $c["holding_object"]; up = $c["tool_position_2"] - z }
+        END { print (h == 1 ? (up >= 0.075 ? "lifted" : "not lifted") : "dropped") }' || true)
+    case "$last" in
+      lifted|"") ;;
+      *) held=no; note="${note:+$note; }held at the CLOSE, $last after" ;;
+    esac
   fi
   dropped=$(sed -n 's/.*dropped \([0-9]*\) late.*/\1/p' "$dir/cameras.txt" | tail -1)
   [ -n "$dropped" ] || dropped="-"
@@ -376,7 +390,7 @@ run_grasp() {
   t0=$(now)
   local flags=(--build-dir "$build_dir")
   [ "$record" -eq 1 ] || flags+=(--no-record)
-  scripts/multicast.sh run "$0" "${flags[@]}" --inside grasp "$dir" > "$dir/run.txt" 2>&1 &
+  scripts/multicast.sh run "$self" "${flags[@]}" --inside grasp "$dir" > "$dir/run.txt" 2>&1 &
   local child=$!
   # A background job ignores SIGINT: the outer script's clean-up sends TERM, passed on here.
   trap 'kill -TERM "$child" 2>/dev/null; wait "$child" 2>/dev/null; exit 143' TERM
@@ -384,8 +398,9 @@ run_grasp() {
   trap - TERM
   elapsed "$t0" > "$dir/wall_s"
   judge_grasp "$dir" > "$dir/result.tsv"
-  if [ "$report" = all ] ||
-     { [ "$report" = failed ] && ! cut -f11,12 "$dir/result.tsv" | grep -q $'^yes\tsuccess$'; }; then
+  local good=0
+  cut -f11,12 "$dir/result.tsv" | grep -q $'^yes\tsuccess$' && good=1
+  if [ "$report" = all ] || { [ "$report" = failed ] && [ "$good" -eq 0 ]; }; then
     [ -s "$dir/session.lcmlog" ] &&
       "$build_dir/bin/sg-report" "$dir/session.lcmlog" --no-plots --quiet \
         --out "$dir/report" > /dev/null 2>&1 || true
@@ -427,7 +442,7 @@ prepare_calibration() {
     echo "$me: calibration, robot-guided: the arm carries the ball through a grid"
     local t0
     t0=$(now)
-    scripts/multicast.sh run "$0" --build-dir "$build_dir" --inside calibrate \
+    scripts/multicast.sh run "$self" --build-dir "$build_dir" --inside calibrate \
       "$calibration_file" "$out/calibration" ||
       die "the robot-guided calibration failed (see $out/calibration/)"
     echo "$me: calibration done in $(elapsed "$t0") s: $calibration_file"
@@ -452,10 +467,11 @@ prepare_coefficients() {
 }
 
 summary() {
-  local n=$1 held agree wall lo hi p50 p95 max
+  local n=$1 held agree wall lo hi p50 p95 max pct
   held=$(awk -F'\t' 'NR > 1 && $11 == "yes"' "$out/results.tsv" | wc -l)
   agree=$(awk -F'\t' 'NR > 1 && (($11 == "yes") == ($12 == "success"))' "$out/results.tsv" | wc -l)
   read -r lo hi <<< "$(wilson "$held" "$n")"
+  pct=$(awk -v h="$held" -v n="$n" 'BEGIN { printf "%.0f", 100 * h / n }')
   p50=$(awk -F'\t' 'NR > 1 && $13 != "-" { print $13 }' "$out/results.tsv" | percentile 0.5)
   p95=$(awk -F'\t' 'NR > 1 && $13 != "-" { print $13 }' "$out/results.tsv" | percentile 0.95)
   max=$(awk -F'\t' 'NR > 1 && $13 != "-" { print $13 }' "$out/results.tsv" | percentile 1)
@@ -464,18 +480,19 @@ summary() {
     echo "# Live grasps: scripts/live_grasps.sh"
     echo
     echo "$(date -u +%Y-%m-%dT%H:%M:%SZ), $(hostname), $(nproc) cores; --seed $seed, $n grasps" \
-      "(--only ${only:-all}), --jobs $jobs, --warmup $warmup s, --grasp-window $window s," \
+      "($([ -n "$only" ] && echo "--only $only" || echo "grasps 0..$((n - 1))")), --jobs $jobs," \
+      "--warmup $warmup s, --grasp-window $window s," \
       "--rate $rate Hz, calibration $calibration_source."
     echo
-    echo "**held $held of $n** ($(awk -v h="$held" -v n="$n" 'BEGIN { printf "%.0f", 100 * h / n }')%," \
-      "95% Wilson interval $lo-$hi%); sg-grasp's own verdict agrees in $agree of $n;" \
+    echo "**held $held of $n** ($pct%, 95% Wilson interval $lo-$hi%);" \
+      "sg-grasp's own verdict agrees in $agree of $n;" \
       "miss at the CLOSE p50 $p50 mm, p95 $p95 mm, max $max mm; wall time $wall s."
     echo
     printf '| %s ' "${columns[@]}"
     echo "|"
     printf '|---%.0s' "${columns[@]}"
     echo "|"
-    awk -F'\t' 'NR > 1 { line = "|"; for (i = 1; i <= NF; ++i) line = line " " $i " |"; print line }' \
+    awk -F'\t' 'NR > 1 { s = "|"; for (i = 1; i <= NF; ++i) s = s " " $i " |"; print s }' \
       "$out/results.tsv"
     echo
     echo "Re-run grasp K: \`scripts/live_grasps.sh --seed $seed --only K --warmup $warmup" \
@@ -499,7 +516,8 @@ main() {
   check_options
   for b in sg-c550-sim sg-arm-driver sg-camera-sim sg-vision sg-predictor sg-grasp sg-grasp-ctl \
            sg-calibrate sg-keygen sg-report; do
-    [ -x "$build_dir/bin/$b" ] || die "$build_dir/bin/$b not found: build first (scripts/bootstrap.sh)"
+    [ -x "$build_dir/bin/$b" ] ||
+      die "$build_dir/bin/$b not found: build first (scripts/bootstrap.sh)"
   done
   [ "$record" -eq 0 ] || command -v lcm-logger > /dev/null ||
     die "lcm-logger not found (scripts/bootstrap.sh installs it), or use --no-record"
