@@ -59,6 +59,7 @@ struct Options {
   std::vector<double> points;  // the sweep's values (empty: its defaults)
   std::string out = ".";       // where a sweep's table, data and plot go
   bool verbose = false;
+  int only = -1;  // --trial: only this trial of the draw (the others are not run)
   double occluded_fraction = 1.0;
   double warmup = 40.0;
   double grasp_window = 20.0;
@@ -132,34 +133,39 @@ struct ModeSummary {
   double seconds = 0;
 };
 
+/// The draw's index of the i-th trial run: i, or --trial's.
+int index_of(const Options& o, int i) { return o.only >= 0 ? o.only : i; }
+
 /// --verbose: a line per trial.
 void print_trials(const Options& o, const ModeSummary& m, const Tweak& tweak) {
   std::printf("\n%s, per trial:\n", m.name);
   std::printf(
       "trial  rpm  r(m) drift  grasp_s  close_s held mach  miss_mm  aim_mm  dT_ms  age_s  "
       "vis_mm  state / message\n");
-  for (int i = 0; i < o.trials; ++i) {
-    auto p = draw_trial(o, i);
+  for (int i = 0; i < static_cast<int>(m.results.size()); ++i) {
+    auto p = draw_trial(o, index_of(o, i));
     if (tweak) tweak(p);
     const auto& r = m.results[static_cast<size_t>(i)];
     std::printf(
-        "%5d %4.2f %5.3f %5.4f %7.2f %8.2f %4s %4s %8.1f %7.1f %6.0f %6.2f %7.2f  %s / %s%s\n", i,
-        p.sim.scenario.rpm, p.sim.scenario.radius, p.sim.scenario.drift_speed, r.grasp_time,
-        r.close_time, r.success ? "yes" : "no", sg::grasp::to_string(r.outcome),
+        "%5d %4.2f %5.3f %5.4f %7.2f %8.2f %4s %4s %8.1f %7.1f %6.0f %6.2f %7.2f  %s / %s%s\n",
+        index_of(o, i), p.sim.scenario.rpm, p.sim.scenario.radius, p.sim.scenario.drift_speed,
+        r.grasp_time, r.close_time, r.success ? "yes" : "no", sg::grasp::to_string(r.outcome),
         r.miss_distance * 1e3, r.aim_error * 1e3, r.timing_error * 1e3, r.track_age,
         r.vision_rms * 1e3, sg::grasp::to_string(r.final_state), r.message.c_str(),
         r.arm_rejection.empty() ? "" : (" [arm: " + r.arm_rejection + "]").c_str());
+    if (o.only >= 0) std::printf("      approach sent: %s\n", r.approach_message.c_str());
   }
 }
 
 ModeSummary run_mode(const Options& o, Mode mode, const Tweak& tweak = {}) {
   ModeSummary m{name_of(mode), {}, 0};
-  m.results.resize(static_cast<size_t>(o.trials));
+  const int n = o.only >= 0 ? 1 : o.trials;
+  m.results.resize(static_cast<size_t>(n));
   std::atomic<int> next{0};
   const auto start = std::chrono::steady_clock::now();
   auto worker = [&] {
-    for (int i = next++; i < o.trials; i = next++) {
-      sg::system::TrialParams p = draw_trial(o, i);
+    for (int i = next++; i < n; i = next++) {
+      sg::system::TrialParams p = draw_trial(o, index_of(o, i));
       if (tweak) tweak(p);
       apply_mode(mode, p);
       m.results[static_cast<size_t>(i)] = sg::system::run_grasp_trial(p);
@@ -191,7 +197,7 @@ int held_of(const ModeSummary& m) {
 void print_table(const Options& o, const std::vector<ModeSummary>& modes) {
   std::printf(
       "\ngrasp_success: %d trials, seed %llu, %s, %s, %d thread(s), occluded fraction %.2f\n",
-      o.trials, static_cast<unsigned long long>(o.seed),
+      static_cast<int>(modes.front().results.size()), static_cast<unsigned long long>(o.seed),
       o.no_render ? "camera model (--no-render)" : "rendered frames + vision",
       o.cameras ? "robot-guided calibration" : "the simulator's true cameras", o.threads,
       o.occluded_fraction);
@@ -280,7 +286,7 @@ std::string sweep_script(const Sweep& sw, const Options& o, const std::vector<Mo
                   gnuplot_string(sw.axis) +
                   "\nset ylabel 'held after the lift (%)'\nset yrange [0:105]\n"
                   "set grid lc rgb '" +
-                  pal::kGrid.hex() + "'\nset key bottom left\nplot ";
+                  pal::kGrid.hex() + "'\nset key below\nplot ";
   bool first = true;
   for (size_t i = 0; i < modes.size(); ++i) {
     if (blocks[i] < 0) continue;
@@ -395,6 +401,10 @@ int main(int argc, char** argv) {
   app.add_option("--points", o.points, "the sweep's values (default: its own list)");
   app.add_option("--out", o.out, "directory for a sweep's .md, .dat, .gp and .png");
   app.add_flag("--verbose", o.verbose, "per-trial diagnostics");
+  app.add_option("--trial", o.only,
+                 "run only this trial of the draw (0 .. trials - 1), e.g. a miss --verbose listed; "
+                 "with --verbose, also the machine's message when it sent the approach")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--occluded-fraction", o.occluded_fraction,
                  "fraction of trials with a total occlusion covering the close")
       ->check(CLI::Range(0.0, 1.0));

@@ -201,7 +201,10 @@ void Trial::grasp_loop(double) {
   if (out.lease) send_arm_command(*out.lease);  // MODE_HEARTBEAT / MODE_RELEASE
   if (!out.arm_command) return;
   ++result_.requests;
-  if (out.arm_command->gripper == arm_cmd_t::GRIPPER_CLOSE) close_command_ = out.arm_command;
+  if (out.arm_command->gripper == arm_cmd_t::GRIPPER_CLOSE) {
+    close_command_ = out.arm_command;
+    result_.approach_message = node_.machine().status().message;
+  }
   send_arm_command(*out.arm_command);
 }
 

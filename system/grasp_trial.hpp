@@ -95,6 +95,7 @@ struct TrialResult {
   grasp::GraspOutcome outcome = grasp::GraspOutcome::kNone;
   grasp::GraspState final_state = grasp::GraspState::kHandOpened;
   std::string message;               ///< the machine's last status message
+  std::string approach_message;      ///< ... when it sent the approach that closes the hand
   std::string arm_rejection;         ///< the last reason the driver or controller refused
   int frames = 0;                    ///< stereo frames
   int visible = 0;                   ///< of which OBJECT_POSITION was visible
