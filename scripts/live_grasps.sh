@@ -129,11 +129,23 @@ check_options() {
 now() { date +%s.%N; }
 elapsed() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.0f", b - a }'; }
 
+# Runs a command in the background and waits for it: a signal's trap runs at once, not after the
+# command (bash defers traps while a foreground command runs); stop_all ends it with the rest.
+interruptible() {
+  "$@" &
+  local p=$!
+  pids+=("$p")
+  local status=0
+  wait "$p" || status=$?
+  unset 'pids[-1]'
+  return "$status"
+}
+
 # Sleeps until the epoch time $1 (at once if it is past).
 sleep_until() {
   local left
   left=$(awk -v t="$1" -v n="$(now)" 'BEGIN { d = t - n; printf "%.3f", (d > 0 ? d : 0) }')
-  sleep "$left"
+  interruptible sleep "$left"
 }
 
 # A uniform draw in [0, 1) from the string $1: the first 52 bits of its SHA-256.
@@ -216,12 +228,12 @@ ask_grasp() {
   local bin=$1 log=$2 status=1
   for attempt in 1 2 3 4 5; do
     set +e
-    "$bin/sg-grasp-ctl" grasp --wait --timeout 40 >> "$log" 2>&1
+    interruptible "$bin/sg-grasp-ctl" grasp --wait --timeout 40 >> "$log" 2>&1
     status=$?
     set -e
     echo "attempt $attempt: exit $status at $(now)" >> "$log"
     [ "$status" -eq 4 ] || break
-    sleep 1
+    interruptible sleep 1
   done
   echo "$status"
 }
@@ -258,14 +270,14 @@ inside_grasp() {
   sleep_until "$(awk -v s="$start" 'BEGIN { printf "%.3f", s + 3 }')"
   local tracked=0
   for _ in 1 2 3 4 5; do
-    if "$bin/sg-grasp-ctl" track >> "$dir/ctl.txt" 2>&1; then tracked=1; break; fi
-    sleep 1
+    if interruptible "$bin/sg-grasp-ctl" track >> "$dir/ctl.txt" 2>&1; then tracked=1; break; fi
+    interruptible sleep 1
   done
   [ "$tracked" -eq 1 ] || echo "track: never accepted" >> "$dir/ctl.txt"
   sleep_until "$(awk -v s="$start" -v g="$grasp_time" 'BEGIN { printf "%.3f", s + g }')"
   echo "grasp asked at $(now) ($(elapsed "$start") s after the cameras started)" >> "$dir/ctl.txt"
   ask_grasp "$bin" "$dir/ctl.txt" > "$dir/ctl.status"
-  sleep 1  # the lift's last SIM_ARM_STATE into the log
+  interruptible sleep 1  # the lift's last SIM_ARM_STATE into the log
   # The cameras' own count of frames dropped is printed when they stop: stop them first.
   kill -INT "$cameras" 2>/dev/null || true
   wait "$cameras" 2>/dev/null || true
@@ -454,6 +466,7 @@ prepare_coefficients() {
   if [ -n "$coefficients" ]; then
     [ "$(realpath "$coefficients")" = "$(realpath -m "$coefficients_file")" ] ||
       cp "$coefficients" "$coefficients_file"
+    echo "$me: predictor coefficients: $coefficients_file (given: $coefficients)"
     return 0
   fi
   # Four minutes of the paper's circle at 4 Hz, t,x,y,z: what Burg's predictors start from.
