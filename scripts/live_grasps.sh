@@ -469,10 +469,12 @@ prepare_coefficients() {
     echo "$me: predictor coefficients: $coefficients_file (given: $coefficients)"
     return 0
   fi
-  # Four minutes of the paper's circle at 4 Hz, t,x,y,z: what Burg's predictors start from.
-  awk 'BEGIN { pi = atan2(0, -1); for (k = 0; k < 960; k++) { t = k * 0.25; a = 2 * pi * t / 60;
-    printf "%.2f,%.6f,%.6f,0.10\n", t, 0.45 + 0.15 * cos(a), 0.15 * sin(a) } }' \
-    > "$out/circle.csv"
+  # Four minutes of the paper's circle at 4 Hz, t,x,y,z, with 1 mm of noise per axis (seeded), as
+  # scripts/demo.sh trains them: what Burg's predictors start from (docs/prediction.md).
+  awk 'function g() { return sqrt(-2 * log(1 - rand())) * cos(2 * pi * rand()) }
+    BEGIN { srand(7); pi = atan2(0, -1); for (k = 0; k < 960; k++) { t = k * 0.25;
+    a = 2 * pi * t / 60; printf "%.2f,%.6f,%.6f,%.6f\n", t, 0.45 + 0.15 * cos(a) + 0.001 * g(),
+    0.15 * sin(a) + 0.001 * g(), 0.10 + 0.001 * g() } }' > "$out/circle.csv"
   "$build_dir/bin/sg-predictor" train "$out/circle.csv" --out "$coefficients_file" > /dev/null ||
     die "sg-predictor train failed"
   rm -f "$out/circle.csv"
