@@ -17,9 +17,10 @@ ForecastError::ForecastError(int horizon, int max_gap, const ForecastErrorParams
       !std::isfinite(p.min_sigma))
     throw std::invalid_argument("forecast error: prior_sigma and min_sigma must be positive");
   if (p.surprise_window < 0 || p.surprise_window > 64 || !(p.surprise_threshold > 0) ||
-      !std::isfinite(p.surprise_threshold))
+      !std::isfinite(p.surprise_threshold) || p.fresh_scores < 0 || p.fresh_scores > kMaxWindow)
     throw std::invalid_argument(
-        "forecast error: surprise_window must be 0 to 64 and surprise_threshold positive");
+        "forecast error: surprise_window must be 0 to 64, surprise_threshold positive and "
+        "fresh_scores 0 to 10000");
   const size_t n = static_cast<size_t>(horizon) + static_cast<size_t>(max_gap);
   const size_t w = static_cast<size_t>(p.window);
   window_.assign(n * w, Eigen::Vector3d::Zero());
@@ -33,7 +34,8 @@ ForecastError::ForecastError(int horizon, int max_gap, const ForecastErrorParams
   surprise_sum_.assign(n, Surprise{});
   surprise_filled_.assign(n, 0);
   turn_.assign(n, Eigen::Vector3d::Zero());
-  for (size_t b = 0; b < n; ++b) {  // the prior is each window's first entry
+  fresh_.assign(n, p.fresh_scores);  // the prior is the estimate itself until scores come
+  for (size_t b = 0; b < n; ++b) {   // the prior is each window's first entry
     const double s = p.prior_sigma * static_cast<double>(b + 1);
     window_[b * w] = sum_[b] = Eigen::Vector3d::Constant(s * s);
   }
@@ -114,6 +116,7 @@ void ForecastError::score(int64_t utime, const Eigen::Vector3d& sample,
     add_surprise(b, {(e.cwiseAbs2().array() / expected.array()).mean(), e.cwiseAbs2() - expected});
     add(b, e.cwiseAbs2(), noise);
     ++scores_[b];
+    fresh_[b] = std::min(fresh_[b] + 1, params_.fresh_scores);
   }
   update_turn();
 }
@@ -156,6 +159,7 @@ void ForecastError::reset() {
   next_ = 0;
   count_ = 0;
   scored_ = false;
+  std::fill(fresh_.begin(), fresh_.end(), 0);
 }
 
 Eigen::Vector3d ForecastError::estimate(size_t b) const {
@@ -166,7 +170,9 @@ Eigen::Vector3d ForecastError::estimate(size_t b) const {
 Eigen::Vector3d ForecastError::sigma(int samples) const {
   const size_t b = bucket(samples);
   const double widen = params_.predictive ? predictive_factor(filled_[b]) : 1.0;
-  const Eigen::Vector3d s = widen * estimate(b);
+  Eigen::Vector3d s = widen * estimate(b);
+  if (fresh_[b] < params_.fresh_scores)  // a new model: no surer than the prior until scored
+    s = s.cwiseMax(params_.prior_sigma * static_cast<double>(b + 1));
   return (s.cwiseAbs2() + turn_[b].cwiseAbs2()).cwiseSqrt();
 }
 

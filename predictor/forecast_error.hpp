@@ -47,7 +47,8 @@
 /// in 8 for 4 scores and c = 1.5) adds about b 0.7 s_b' (docs/prediction.md).
 /// The estimates survive
 /// reset() (they describe the predictor on this motion, not one track); the kept forecasts do not
-/// (their grid is gone).
+/// (their grid is gone), and until `fresh_scores` forecasts of the new model have been scored at a
+/// horizon, its sigma is at least the prior's (a restarted model is not yet as good as the old).
 ///
 ///     ForecastError error(16, 16);                  // horizon H, max_gap: horizons 1 .. H + 16
 ///     error.score(sample_utime, sample);            // a measured grid sample, before ...
@@ -74,6 +75,10 @@ struct ForecastErrorParams {
   int surprise_window = 4;
   /// Mean z^2 above which a bucket is surprised (its excess then counts in the turn term).
   double surprise_threshold = 1.5;
+  /// After reset() (a new model: the predictor restarted its axes), a horizon's sigma is at least
+  /// the prior, prior_sigma * b per axis, until this many forecasts made since have been scored
+  /// there: the estimates describe the old model, and a fresh one is not yet as good (0: never).
+  int fresh_scores = 8;
 };
 
 class ForecastError {
@@ -100,7 +105,8 @@ class ForecastError {
   /// not against a noisy measurement of it (zero: none known).
   void score(int64_t utime, const Eigen::Vector3d& sample,
              const Eigen::Vector3d& sample_sigma = Eigen::Vector3d::Zero());
-  /// Forgets the kept forecasts (a new track, a new grid); the estimates stay.
+  /// Forgets the kept forecasts (a new track, a new grid); the estimates stay, but each horizon
+  /// claims no more than the prior until `fresh_scores` new forecasts have been scored there.
   void reset();
 
   /// 1-sigma error per axis (m) of a point `samples` grid samples past the last measurement
@@ -151,6 +157,7 @@ class ForecastError {
   std::vector<Surprise> surprise_sum_;   // per bucket: the sum of its ring
   std::vector<int> surprise_filled_;     // per bucket: entries in its ring
   std::vector<Eigen::Vector3d> turn_;    // per bucket: T_b
+  std::vector<int> fresh_;               // per bucket: scores since reset(), up to fresh_scores
   std::vector<Kept> kept_;               // a ring of the last `horizon` forecasts
   size_t next_ = 0;                      // where the next forecast goes
   size_t count_ = 0;                     // forecasts held

@@ -22,6 +22,9 @@ Eigen::Vector3d truth(int k) {
   return {0.45 + 0.15 * std::cos(0.1 * k), 0.15 * std::sin(0.1 * k), 0.2};
 }
 
+/// The error of every forecast in the fresh-model test.
+Eigen::Vector3d usual_error() { return {0.010, 0, 0}; }
+
 /// Runs `n` grid samples: sample k is scored, then the forecast made at it, truth(k + h) +
 /// error(k, h), is recorded after `occluded` fed-back samples.
 template <class Error>
@@ -197,6 +200,32 @@ TEST(ForecastError, SurpriseSettings) {
   EXPECT_THROW(ForecastError(kH, 4, {.surprise_window = 65}), std::invalid_argument);
   EXPECT_THROW(ForecastError(kH, 4, {.surprise_threshold = 0}), std::invalid_argument);
   EXPECT_THROW(ForecastError(kH, 4, {.surprise_threshold = NAN}), std::invalid_argument);
+}
+
+// A new model claims no more than the prior: after reset() each horizon's sigma is at least
+// prior_sigma * b (5 mm a sample) until 8 forecasts made since have been scored there, then the
+// estimate again (10 mm at every horizon here, below the prior from h = 3 on).
+TEST(ForecastError, AFreshModelIsNoSurerThanThePrior) {
+  ForecastError model(kH, 0, {.predictive = false});
+  run(model, 2000, 0, [](int, int) { return Eigen::Vector3d(0.010, 0, 0); });
+  EXPECT_NEAR(model.sigma(7).x(), 0.010, 1e-9);
+  model.reset();
+  EXPECT_NEAR(model.sigma(1).x(), 0.010, 1e-9) << "the estimate, above the prior's 5 mm";
+  EXPECT_NEAR(model.sigma(7).x(), 0.035, 1e-12);
+  EXPECT_NEAR(model.sigma(7).y(), 0.035, 1e-12) << "every axis";
+  std::vector<Eigen::Vector3d> f(kH);
+  for (int k = 3000; k < 3000 + 7 + 8; ++k) {  // 8 scores at h = 7 by the last sample
+    const int64_t t = kT0 + k * kPeriod;
+    model.score(t, truth(k));
+    if (k == 3000 + 7 + 6) {
+      EXPECT_NEAR(model.sigma(7).x(), 0.035, 1e-12) << "7 scores";
+    }
+    for (int h = 1; h <= kH; ++h) f[static_cast<size_t>(h - 1)] = truth(k + h) + usual_error();
+    model.record(t, 0, f, kPeriod);
+  }
+  EXPECT_NEAR(model.sigma(7).x(), 0.010, 1e-9) << "8 scores: the estimate";
+  EXPECT_NEAR(model.sigma(16).x(), 0.080, 1e-12) << "h = 16: no score yet";
+  EXPECT_THROW(ForecastError(kH, 0, {.fresh_scores = -1}), std::invalid_argument);
 }
 
 // A forecast made 3 samples into an occlusion forecasts its point h for h + 3 samples past the

@@ -237,6 +237,11 @@ TEST(Predictor, OcclusionFeedbackRecoveryAndLoss) {
   const auto again = step(true);
   ASSERT_EQ(again.size(), 1u);
   EXPECT_EQ(again[0].status, TrackStatus::kTracking);
+  // The restarted model claims no more than the prior (5 mm a sample of horizon), where the old
+  // one was sure to a fraction of a millimetre.
+  const double prior = PredictorParams{}.error.prior_sigma;
+  for (int h : {1, 7, 16})
+    EXPECT_GE(again[0].sigma[static_cast<size_t>(h - 1)].minCoeff(), prior * h - 1e-12) << h;
 }
 
 // Every forecast carries a sigma per point: the error model's at h samples past a measurement
