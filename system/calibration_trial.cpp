@@ -17,16 +17,8 @@ namespace {
 using stereograsp::arm_cmd_t;
 using stereograsp::arm_status_t;
 
-/// sg-arm-driver's loop handles the bus for 5 ms, then publishes ARM_STATUS when due.
-constexpr double kDriverLoopPeriod = 0.005;
 /// sg-calibrate's commander: a heartbeat this often while it holds the lease.
 constexpr double kHeartbeatPeriod = 0.2;
-
-auth::LabKey calibration_key() {
-  std::array<uint8_t, auth::LabKey::kSize> bytes;
-  for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = static_cast<uint8_t>(0x5A ^ (i * 11));
-  return auth::LabKey(bytes);
-}
 
 /// sg-calibrate's command for a stop (vision/sg_calibrate_main.cpp, command_to).
 arm_cmd_t command_to(const vision::ArmTarget& t) {
@@ -58,7 +50,7 @@ class CalibrationRun {
 
   CalibrationTrialParams p_;
   SimulatedClock clock_;
-  auth::LabKey key_ = calibration_key();
+  auth::LabKey key_ = trial_lab_key();
   SimulatedArm arm_;
   sim::CameraSimulator camera_;
   sim::StereoFrame frame_;

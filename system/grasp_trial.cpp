@@ -27,16 +27,6 @@ using stereograsp::point3_t;
 
 /// sg-grasp's loop handles the bus for 10 ms, then polls the node.
 constexpr double kGraspLoopPeriod = 0.010;
-/// sg-arm-driver's loop handles the bus for 5 ms, then publishes ARM_STATUS when due.
-constexpr double kDriverLoopPeriod = 0.005;
-
-/// The trial's lab key: fixed bytes (the trial signs and checks as the lab does; no secret here).
-auth::LabKey trial_key() {
-  std::array<uint8_t, auth::LabKey::kSize> bytes;
-  for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = static_cast<uint8_t>(0xA5 ^ (i * 7));
-  return auth::LabKey(bytes);
-}
-
 /// A message as its subscribers receive it: encoded and decoded as on the bus.
 template <class T>
 T over_bus(const T& message) {
@@ -91,7 +81,7 @@ class Trial {
   std::unique_ptr<sim::CameraSimulator> camera_;
   sim::StereoFrame frame_;
   std::mt19937_64 noise_rng_;
-  auth::LabKey key_ = trial_key();
+  auth::LabKey key_ = trial_lab_key();
   SimulatedArm arm_;  // the C550 on its line, sg-arm-driver's core
   vision::StereoStep vision_;
   predictor::TrajectoryPredictor predictor_;

@@ -1,5 +1,6 @@
 #include "system/simulated_arm.hpp"
 
+#include <array>
 #include <stdexcept>
 #include <utility>
 
@@ -15,6 +16,12 @@ double checked_period(double rate) {
 }
 
 }  // namespace
+
+auth::LabKey trial_lab_key() {
+  std::array<uint8_t, auth::LabKey::kSize> bytes;
+  for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = static_cast<uint8_t>(0xA5 ^ (i * 7));
+  return auth::LabKey(bytes);
+}
 
 SimulatedArm::SimulatedArm(const SimulatedArmParams& params, SimulatedClock& clock,
                            const auth::LabKey& key, BallAt ball_at)

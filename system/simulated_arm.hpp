@@ -25,6 +25,7 @@
 
 #include "arm_driver/arm_driver.hpp"
 #include "auth/command_auth.hpp"
+#include "auth/lab_key.hpp"
 #include "common/change_or_period.hpp"
 #include "sim/c550_controller.hpp"
 #include "sim/c550_emulator.hpp"
@@ -33,6 +34,14 @@
 #include "system/simulated_line.hpp"
 
 namespace sg::system {
+
+/// sg-arm-driver's loop handles the bus for 5 ms, then publishes ARM_STATUS when due: the period at
+/// which a trial calls SimulatedArm::status_due.
+inline constexpr double kDriverLoopPeriod = 0.005;
+
+/// The lab key of the in-process trials: fixed bytes (a trial signs and checks every command as
+/// the lab does; there is no secret in simulated time).
+auth::LabKey trial_lab_key();
 
 /// The arm's parts and their settings.
 struct SimulatedArmParams {

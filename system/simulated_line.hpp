@@ -13,7 +13,8 @@
 ///     C550Emulator emulator(controller);
 ///     SimulatedLine line(emulator, clock, {.before_pump = [&](double t) {
 ///       emulator.set_ball_centre(world.ball_at(t)); }});
-///     C550Link link(line, 1, {}, clock);  // or ArmDriver(..., [&] { return line.connect(); }, clock)
+///     C550Link link(line, 1, {}, clock);  // or ArmDriver(..., [&] { return line.connect(); },
+///     clock)
 
 #include <deque>
 #include <functional>
