@@ -25,7 +25,6 @@ using Vec3 = Eigen::Vector3d;
 using Status = stereograsp::grasp_status_t;
 
 constexpr int64_t kT0 = 1'700'000'000'000'000;
-constexpr int64_t kSecond = 1'000'000;
 
 int64_t at_s(double seconds) { return kT0 + static_cast<int64_t>(std::llround(seconds * 1e6)); }
 
