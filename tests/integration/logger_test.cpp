@@ -69,7 +69,10 @@ TEST_F(LoggerTest, LogFileReadsBackExactlyWhatWasSent) {
     EXPECT_TRUE(verdict->intact) << "event " << events;
     EXPECT_EQ(verdict->type_index, events % bus_check::type_count()) << "sent in this order";
     EXPECT_GT(verdict->utime, last_utime) << "sent in this order";
-    EXPECT_GE(event->timestamp, last_timestamp) << "receive times are monotonic";
+    // Receive times are wall-clock stamps, not a monotonic clock's: a loaded sanitized run saw one
+    // 0.9 ms before the one logged ahead of it (the datagrams themselves in order). In order, to
+    // within 5 ms.
+    EXPECT_GE(event->timestamp, last_timestamp - 5000) << "receive times in order";
     EXPECT_GE(event->timestamp, verdict->utime) << "received after it was sent";
     last_utime = verdict->utime;
     last_timestamp = event->timestamp;
