@@ -33,16 +33,21 @@ class BallTrack {
     newest_ = Sample{utime, centre};
   }
 
-  /// The centre at `utime`; nullopt before any sample.
+  /// The centre at `utime`; nullopt before any sample. Any GROUND_TRUTH can arrive (times
+  /// near the int64 limits, centres near 1e308): the times are subtracted in double, never
+  /// overflowing, the extrapolation stays within max_extrapolation either side of the newest
+  /// sample, and a result that is not finite is the newest sample.
   std::optional<Eigen::Vector3d> at(int64_t utime) const {
     if (!newest_) return std::nullopt;
     if (!previous_) return newest_->centre;
-    const int64_t span = newest_->utime - previous_->utime;
-    if (span <= 0 || span > kMaxGap) return newest_->centre;
-    const int64_t ahead = std::min(utime - newest_->utime, kMaxExtrapolation);
-    const Eigen::Vector3d velocity =
-        (newest_->centre - previous_->centre) / static_cast<double>(span);
-    return Eigen::Vector3d(newest_->centre + velocity * static_cast<double>(ahead));
+    const double span = static_cast<double>(newest_->utime) - static_cast<double>(previous_->utime);
+    if (!(span > 0) || span > kMaxGap) return newest_->centre;
+    const double limit = static_cast<double>(kMaxExtrapolation);
+    const double ahead =
+        std::clamp(static_cast<double>(utime) - static_cast<double>(newest_->utime), -limit, limit);
+    const Eigen::Vector3d p =
+        newest_->centre + (newest_->centre - previous_->centre) * (ahead / span);
+    return p.allFinite() ? p : newest_->centre;
   }
 
  private:

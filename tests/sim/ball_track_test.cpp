@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 namespace sg::sim {
 namespace {
@@ -75,6 +76,25 @@ TEST(BallTrack, AnUnknownBallClearsIt) {
   track.add(0, {0, 0, 0});
   track.add(kFrame, {NAN, 0, 0});
   EXPECT_FALSE(track.at(kFrame).has_value());
+}
+
+// Hostile GROUND_TRUTH: times at the int64 limits and centres near 1e308 neither overflow nor
+// give a non-finite centre; a time far before the newest frame extrapolates back at most 0.5 s.
+TEST(BallTrack, HostileTimesAndCentresStayFinite) {
+  constexpr int64_t kMin = std::numeric_limits<int64_t>::min();
+  constexpr int64_t kMax = std::numeric_limits<int64_t>::max();
+  BallTrack track;
+  track.add(kMin, Eigen::Vector3d(0, 0, 0));
+  track.add(kMax, Eigen::Vector3d(1, 0, 0));
+  EXPECT_EQ(*track.at(0), Eigen::Vector3d(1, 0, 0)) << "frames too far apart: held";
+  EXPECT_EQ(*track.at(kMin), Eigen::Vector3d(1, 0, 0));
+  track.add(0, Eigen::Vector3d(1e308, 0, 0));
+  track.add(250'000, Eigen::Vector3d(-1e308, 0, 0));
+  EXPECT_EQ(*track.at(500'000), Eigen::Vector3d(-1e308, 0, 0)) << "overflowed: the newest";
+  BallTrack back;
+  back.add(1'000'000, Eigen::Vector3d(0, 0, 0));
+  back.add(1'250'000, Eigen::Vector3d(0.25, 0, 0));  // 1 m/s
+  EXPECT_NEAR(back.at(kMin)->x(), 0.25 - 0.5, 1e-12);
 }
 
 }  // namespace
