@@ -57,7 +57,9 @@ bool SessionPhase::advance(int64_t recv) {
     return update(recv);
   }
   if (recv > last_recv_) {
-    time_in_[static_cast<int>(current_)] += recv - last_recv_;
+    // In double: recv - last_recv_ overflows int64 for times a hostile log can hold.
+    time_in_[static_cast<int>(current_)] +=
+        static_cast<double>(recv) - static_cast<double>(last_recv_);
     last_recv_ = recv;
   }
   return update(last_recv_);
@@ -98,7 +100,7 @@ std::optional<Phase> SessionPhase::at(int64_t recv) const {
 }
 
 double SessionPhase::seconds_in(Phase phase) const {
-  return static_cast<double>(time_in_[static_cast<int>(phase)]) * 1e-6;
+  return time_in_[static_cast<int>(phase)] * 1e-6;
 }
 
 }  // namespace sg::logger

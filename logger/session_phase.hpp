@@ -83,7 +83,7 @@ class SessionPhase {
   Phase current_ = Phase::kNoGraspMachine;
   std::deque<std::pair<int64_t, Phase>> changes_;  // (receive time, phase from then on)
   bool trimmed_ = false;                           // changes_ lost its oldest entries
-  int64_t time_in_[kPhaseCount] = {};
+  double time_in_[kPhaseCount] = {};               // us; in double: a log's times may be any int64
   // what the rule reads
   bool have_grasp_ = false, arm_commanded_ = false;
   int state_ = 0, activity_ = 0;

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -99,6 +100,15 @@ TEST(SessionPhase, PhaseAtEarlierTimesAndTimeInEach) {
   EXPECT_DOUBLE_EQ(p.seconds_in(Phase::kApproach), 1);
   EXPECT_DOUBLE_EQ(p.seconds_in(Phase::kCarried), 4);
   EXPECT_DOUBLE_EQ(p.seconds_in(Phase::kIdle), 0);
+}
+
+// A log's receive times can be any int64: from the lowest to the highest the time in a phase is
+// their difference, 2^64 us, not an overflowed int64.
+TEST(SessionPhase, TimesAtTheInt64LimitsDoNotOverflow) {
+  SessionPhase p;
+  p.advance(std::numeric_limits<int64_t>::min());
+  p.advance(std::numeric_limits<int64_t>::max());
+  EXPECT_DOUBLE_EQ(p.seconds_in(Phase::kNoGraspMachine), 18446744073709.551616);
 }
 
 // Memory stays bounded: past kMaxChanges changes the oldest are forgotten, and a time before
