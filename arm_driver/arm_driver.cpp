@@ -188,6 +188,11 @@ double ArmDriver::last_overhead() const {
   return overhead_;
 }
 
+uint64_t ArmDriver::gripper_actions_dropped() const {
+  std::lock_guard lock(mutex_);
+  return gripper_actions_dropped_;
+}
+
 bool ArmDriver::connect(std::stop_token stop) {
   double wait = settings_.reconnect_min;
   while (!stop.stop_requested()) {
@@ -251,7 +256,7 @@ void ArmDriver::read_joints() {
   });
 }
 
-void ArmDriver::act(const ArmTarget& target) {
+void ArmDriver::act(ArmTarget& target) {
   const auto& timing = settings_.timing;
   if (target.mode == Cmd::MODE_STOP) {
     link_->command("ABORT", timing.reply_timeout);  // then the gripper, if asked (abort: open)
@@ -261,9 +266,24 @@ void ArmDriver::act(const ArmTarget& target) {
     link_->command("READY", timing.motion_reply);
   }
   motion_done_ = true;
-  if (target.gripper != Cmd::GRIPPER_KEEP) {
-    link_->command(target.gripper == Cmd::GRIPPER_OPEN ? "OPEN" : "CLOSE", timing.motion_reply);
+  if (target.gripper == Cmd::GRIPPER_KEEP) return;
+  if (superseded(target)) {
+    target.gripper = Cmd::GRIPPER_KEEP;  // executed as a motion alone
+    return;
   }
+  link_->command(target.gripper == Cmd::GRIPPER_OPEN ? "OPEN" : "CLOSE", timing.motion_reply);
+}
+
+bool ArmDriver::superseded(const ArmTarget& target) {
+  if (target.mode == Cmd::MODE_STOP || target.mode == Cmd::MODE_GRIPPER_ONLY) return false;
+  std::lock_guard lock(mutex_);
+  if (!pending_) return false;
+  ++gripper_actions_dropped_;
+  spdlog::info("command {}: its {} not sent, command {} waits (latest wins)", target.sequence,
+               target.gripper == Cmd::GRIPPER_OPEN ? "OPEN" : "CLOSE",
+               pending_->internal ? std::string("STOP (watchdog)")
+                                  : std::to_string(pending_->sequence));
+  return true;
 }
 
 void ArmDriver::send_speed(const ArmTarget& target) {

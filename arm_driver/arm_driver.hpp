@@ -15,6 +15,15 @@
 /// motion is pending the pending slot gets the driver's own STOP (ABORT, the gripper kept as it
 /// is), which ARM_STATUS reports in `watchdog` and `error` without a sequence of its own.
 ///
+/// A gripper action gives way. A motion command (MODE_CARTESIAN, MODE_JOINTS, MODE_HOME) that
+/// carries a gripper action sends the motion, waits for its reply (one interaction), then sends
+/// the gripper action: but if by then a newer command waits in the slot, the gripper action is
+/// not sent. The command counts as executed (its motion ran) with the gripper as it was, and the
+/// newer command goes next. This is latest wins applied to the half of a command not yet on the
+/// line: an approach's CLOSE sent from a forecast that a turn has since overtaken gives way to
+/// the re-planned approach (GraspMachine, "Re-planning"), and a watchdog's STOP to a closing hand
+/// is obeyed one interaction sooner. A STOP's OPEN and a MODE_GRIPPER_ONLY action are always sent.
+///
 ///     ArmDriver driver(geometry, settings, [&] { return SerialPort::open(path, serial); });
 ///     std::jthread worker([&](std::stop_token stop) { driver.run(stop); });
 ///     Submission s = driver.submit(command);        // from the bus thread
@@ -99,6 +108,10 @@ class ArmDriver {
   /// benchmark; seconds, of the last interaction.
   double last_overhead() const;
 
+  /// Gripper actions of motion commands not sent because a newer command waited (see the file
+  /// comment, "A gripper action gives way").
+  uint64_t gripper_actions_dropped() const;
+
  private:
   Submission queue(const stereograsp::arm_cmd_t& command);
   Submission refuse_by_lease(const stereograsp::arm_cmd_t& command, const std::string& why);
@@ -110,7 +123,12 @@ class ArmDriver {
   void disconnect(const std::string& why);
   void execute(ArmTarget target);
   void send_speed(const ArmTarget& target);
-  void act(const ArmTarget& target);
+  /// Sends the target's motion, then its gripper action unless superseded(): then the target's
+  /// gripper becomes GRIPPER_KEEP (what was executed).
+  void act(ArmTarget& target);
+  /// Whether a motion's gripper action, not yet sent, gives way to a newer command waiting in
+  /// the slot (counted and logged).
+  bool superseded(const ArmTarget& target);
   void requeue_rest(ArmTarget target);
   void record_executed(const ArmTarget& target);
   void record_refusal(const ArmTarget& target, const std::string& why);
@@ -140,6 +158,7 @@ class ArmDriver {
   stereograsp::arm_status_t status_;
   uint64_t version_ = 0;
   double overhead_ = 0;
+  uint64_t gripper_actions_dropped_ = 0;
 };
 
 /// Copies joints and the tool pose (forward kinematics) into a status.

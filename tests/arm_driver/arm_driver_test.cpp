@@ -543,5 +543,49 @@ TEST_F(ArmDriverTest, ResendsOnlyTheGripperWhenTheLineDropsAfterTheMove) {
   EXPECT_LT(distance(status(), {0.45, 0.0, 0.20}), 1e-3);
 }
 
+// A gripper action gives way: a move with a CLOSE, and a newer move submitted while the first
+// MA's interaction is held. The CLOSE is never sent: the first command counts as executed with
+// the gripper as it was, the newer move follows, and the drop is counted.
+TEST_F(ArmDriverTest, CloseGivesWayToANewerCommandWaiting) {
+  start(/*delay=*/0.3);
+  ASSERT_TRUE(connected());
+  Cmd approach = move_to(1, 0.40, 0.10, 0.25);
+  approach.gripper = Cmd::GRIPPER_CLOSE;
+  driver_->submit(approach);
+  ASSERT_TRUE(eventually([&](const Status&) { return !bench_->executed_starting("MA ").empty(); },
+                         "the approach's MA received by the controller"));
+  const Cmd replanned = move_to(2, 0.42, 0.05, 0.22);
+
+  driver_->submit(replanned);
+
+  ASSERT_TRUE(done(2));
+  EXPECT_EQ(bench_->executed_starting("MA "),
+            (std::vector<std::string>{ma_line(approach, kReady), ma_line(replanned, kReady)}));
+  EXPECT_TRUE(bench_->executed_starting("CLOSE").empty());
+  EXPECT_EQ(status().gripper, Status::GRIPPER_UNKNOWN);
+  EXPECT_EQ(driver_->gripper_actions_dropped(), 1u);
+  EXPECT_LT(distance(status(), {0.42, 0.05, 0.22}), 1e-3);
+}
+
+// A command arriving once the CLOSE is on the line waits for it: the hand closes, the newer move
+// follows, and nothing counts as dropped.
+TEST_F(ArmDriverTest, CloseAlreadySentIsNotUndone) {
+  start(/*delay=*/0.3);
+  ASSERT_TRUE(connected());
+  Cmd approach = move_to(1, 0.40, 0.10, 0.25);
+  approach.gripper = Cmd::GRIPPER_CLOSE;
+  driver_->submit(approach);
+  ASSERT_TRUE(eventually([&](const Status&) { return !bench_->executed_starting("CLOSE").empty(); },
+                         "the approach's CLOSE received by the controller"));
+
+  driver_->submit(move_to(2, 0.42, 0.05, 0.22));
+
+  ASSERT_TRUE(done(2));
+  EXPECT_EQ(bench_->executed_starting("CLOSE"), std::vector<std::string>{"CLOSE"});
+  EXPECT_EQ(bench_->executed_starting("MA ").size(), 2u);
+  EXPECT_EQ(status().gripper, Status::GRIPPER_CLOSED);
+  EXPECT_EQ(driver_->gripper_actions_dropped(), 0u);
+}
+
 }  // namespace
 }  // namespace sg::arm
