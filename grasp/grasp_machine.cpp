@@ -173,6 +173,7 @@ CommandReply GraspMachine::grasp(const std::string& where, int64_t now) {
   status_.state = GraspState::kApproaching;
   status_.activity = GraspActivity::kGrasping;
   grasp_utime_ = now;
+  replans_in_grasp_ = 0;
   status_.last_action = GraspAction::kApproachObject;
   status_.outcome = GraspOutcome::kNone;
   if (next_ == NextAction::kHome) next_ = NextAction::kNone;
@@ -295,7 +296,10 @@ std::optional<ArmRequest> GraspMachine::choose_request(int64_t now) {
   // At once, even with one in flight or ARM_STATUS silent: a STOP is safe, obeyed from anyone.
   if (next_ == NextAction::kStop && now >= retry_utime_) return send_stop(now);
   if (arm_status_silence(now)) return std::nullopt;
-  if (in_flight_) return resend(now);
+  if (in_flight_) {
+    if (std::optional<ArmRequest> r = replan(now)) return r;
+    return resend(now);
+  }
   if (now < retry_utime_) return std::nullopt;
   switch (next_) {
     case NextAction::kOpen:
@@ -312,6 +316,8 @@ std::optional<ArmRequest> GraspMachine::choose_request(int64_t now) {
   }
   const GraspActivity activity = status_.activity;
   if (activity == GraspActivity::kGrasping && status_.state == GraspState::kApproaching) {
+    // A re-plan that came too late left the hand closed: open it before approaching again.
+    if (arm_.gripper == Status::GRIPPER_CLOSED) return send_open(now);
     return send_approach(now);
   }
   if (activity == GraspActivity::kTracking && status_.state == GraspState::kHandOpened) {
@@ -439,6 +445,54 @@ std::optional<ArmRequest> GraspMachine::send_approach(int64_t now) {
     status_.state = GraspState::kGrasping;
     status_.last_action = GraspAction::kCloseHand;
   }
+  return r;
+}
+
+std::string GraspMachine::replan_reason(int64_t now) const {
+  const InFlight& approach = *in_flight_;
+  if (approach.kind != Kind::kApproach || status_.state != GraspState::kGrasping ||
+      status_.activity != GraspActivity::kGrasping || !settings_.use_prediction) {
+    return "";
+  }
+  if (replans_in_grasp_ >= settings_.max_replans) return "";
+  if (now - grasp_utime_ >= to_us(settings_.max_wait)) return "";  // the close on a guess stands
+  // Past this the CLOSE may be on the line already.
+  if (now - approach.sent_utime >= to_us(delay_ - settings_.replan_margin)) return "";
+  int64_t source_utime = 0;
+  const std::optional<PredictedPath> path = fresh_path(now, &source_utime);
+  if (!path || source_utime <= approach.request.source_utime) return "";
+  const int64_t t = approach.request.target_utime;
+  const std::optional<Eigen::Vector3d> ball = path->at(t);
+  if (!ball) return "";
+  // The approach's offset is 0: its tool target is the ball it aimed at.
+  const double shift = (*ball - approach.request.position).norm();
+  if (shift > settings_.replan_shift) return "the ball at T moved " + fixed(shift * 1e3, 1) + " mm";
+  const std::optional<double> sigma = close_sigma(*path, t);
+  if (sigma && settings_.confidence * *sigma > settings_.tolerance) {
+    return "at T " + fixed(settings_.confidence, 1) + " sigma " +
+           fixed(settings_.confidence * *sigma * 1e3, 1) + " mm > " +
+           fixed(settings_.tolerance * 1e3, 1) + " mm tolerance";
+  }
+  return "";
+}
+
+std::optional<ArmRequest> GraspMachine::replan(int64_t now) {
+  const std::string why = replan_reason(now);
+  if (why.empty()) return std::nullopt;
+  const int64_t superseded = in_flight_->sequence;
+  const GraspState state = status_.state;
+  status_.state = GraspState::kApproaching;  // q1's request, now
+  std::optional<ArmRequest> r = send_approach(now);
+  if (!r) {  // no target now: the approach in flight stands
+    status_.state = state;
+    return std::nullopt;
+  }
+  motion_commands_.erase(superseded);  // its interaction may be a motion alone now
+  ++replans_;
+  ++replans_in_grasp_;
+  if (r->gripper != Cmd::GRIPPER_CLOSE) status_.last_action = GraspAction::kApproachObject;
+  set_message("re-planned (request " + std::to_string(superseded) + "): " + why +
+              (status_.message.empty() ? "" : "; " + status_.message));
   return r;
 }
 

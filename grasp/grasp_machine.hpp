@@ -77,6 +77,21 @@
 /// grasp command it closes on its best guess, and says so. A path without sigmas (the
 /// --no-prediction baseline) closes at once, as before.
 ///
+/// Re-planning (issue 17). The approach's CLOSE reaches the controller one delay after the
+/// approach is sent (sg-arm-driver sends the MA, waits for its reply, then the CLOSE), and a newer
+/// command waiting in the driver's slot by then makes the CLOSE give way (ArmDriver, "A gripper
+/// action gives way"). So while q2's approach is in flight and younger than delay_estimate() -
+/// replan_margin, every newer trajectory is checked against it: when it puts the ball at the
+/// approach's T more than replan_shift from the approach's aim, or its sigma_close at T no longer
+/// fits the tolerance (a turn seen after the approach began), the machine sends at once the
+/// request q1 would send now: a new approach with its CLOSE (still q2), or, when no close is
+/// sure, a move above the ball (back to q1, "waiting to close"). The message says why
+/// ("re-planned (request 12): the ball at T moved 23.4 mm"); replans() counts them. At most
+/// max_replans a grasp and only before max_wait, so the grasp command is still carried out
+/// within a bounded wait. A re-plan that came too late (the first CLOSE went out) leaves the hand
+/// closed in q1: q1 then opens it (a0) before approaching again. The superseded approach's
+/// interaction teaches nothing of the delay (it may have been a motion alone).
+///
 /// Transitions: the state and activity after the command and the request it makes (sent by
 /// take_request()); a refused or ignored command changes nothing but status().message.
 ///
@@ -297,6 +312,13 @@ struct GraspSettings {
   double arm_sigma = 0.001;     ///< m, 3D: the arm's and the calibration's error at the tool
   double timing_sigma = 0.035;  ///< s: the spread of the controller's delay (0.72-0.84 s uniform)
   double max_wait = 8.0;        ///< s after the grasp command: then close on the best guess
+  /// Re-planning (see the file comment): the newest forecast of the ball at the approach's T
+  /// this far from the approach's aim re-plans it ...
+  double replan_shift = 0.010;  ///< m
+  /// ... while the approach's CLOSE is surely not yet on the line: until one delay less this
+  /// after the approach was sent ...
+  double replan_margin = 0.15;  ///< s
+  int max_replans = 3;          ///< ... at most this many times a grasp
   InterceptionSettings interception;
   InputGate input_gate;
 };
@@ -373,6 +395,8 @@ class GraspMachine {
   int64_t last_sequence() const { return next_sequence_ - 1; }
   /// Requests sent again under the same sequence so far.
   uint64_t resends() const { return resends_; }
+  /// Approaches re-planned (see the file comment) since the machine started.
+  uint64_t replans() const { return replans_; }
   /// Rejections since the last request the arm executed.
   int consecutive_rejections() const { return rejections_; }
   /// No request but a STOP before this time (the back-off after a rejection; 0: none).
@@ -424,6 +448,11 @@ class GraspMachine {
   std::optional<ArmRequest> send_backoff(int64_t now);
   std::optional<ArmRequest> send_lift(int64_t now);
   std::optional<ArmRequest> send_approach(int64_t now);
+  /// In q2, the approach in flight replaced by a new one (or by tracking, back to q1) when
+  /// replan_reason() gives a reason.
+  std::optional<ArmRequest> replan(int64_t now);
+  /// Why the approach in flight should be re-planned at `now` ("" when it should not).
+  std::string replan_reason(int64_t now) const;
 
   /// The path to aim with at `now` (fresh, not lost), with its source_utime, or nullopt.
   std::optional<PredictedPath> fresh_path(int64_t now, int64_t* source_utime) const;
@@ -497,6 +526,8 @@ class GraspMachine {
   bool message_is_refusal_ = false;
 
   uint64_t resends_ = 0;
+  uint64_t replans_ = 0;
+  int replans_in_grasp_ = 0;
   int rejections_ = 0;              ///< consecutive, reset by an executed request
   int64_t retry_utime_ = 0;         ///< the back-off: no request but a STOP before this
   bool waiting_for_lease_ = false;  ///< the last rejection said another sender commands the arm

@@ -641,6 +641,136 @@ TEST(GraspMachineTest, ConfidenceZeroClosesAtOnce) {
   EXPECT_EQ(kind(rig.take()), Req::kApproach) << rig.status().message;
 }
 
+/// A prediction made at `utime` of a ball that turned back at `utime`: it retraces the circle.
+PredictedPath turned_path(int64_t utime) {
+  PredictedPath path = circle_path(utime);
+  for (int i = 0; i < 16; ++i) path.points[i] = circle(2 * utime - (path.start_utime + i * 250'000));
+  return path;
+}
+
+/// q2 with the approach in flight, sent from sure forecasts (1 mm per axis): the approach.
+ArmRequest approach_in_flight(Rig& rig) {
+  grasp_while_tracking(rig, 0.001);
+  const std::optional<ArmRequest> approach = rig.take();
+  EXPECT_EQ(kind(approach), Req::kApproach) << rig.status().message;
+  EXPECT_EQ(rig.status().state, GraspState::kGrasping);
+  return approach.value_or(ArmRequest{});
+}
+
+// A turn seen 0.25 s after the approach went out (the ball retraces the circle: at T it is
+// about 2 x 15.7 mm/s x 1.3 s = 41 mm from the aim) sends a re-planned approach at once, under a
+// new sequence, aimed at the turned path; the old approach's answer changes nothing, the new
+// one's moves q2 to q3.
+TEST(GraspMachineTest, TurnAfterTheApproachBeganReplansIt) {
+  Rig rig;
+  const ArmRequest first = approach_in_flight(rig);
+  rig.advance(0.25);
+  const PredictedPath turned = turned_path(rig.now);
+  rig.machine.on_trajectory(turned, rig.now - 50'000, rig.now);
+
+  const std::optional<ArmRequest> again = rig.take();
+
+  ASSERT_EQ(kind(again), Req::kApproach) << rig.status().message;
+  EXPECT_EQ(again->sequence, first.sequence + 1);
+  EXPECT_LT((again->position - *turned.at(again->target_utime)).norm(), 1e-9);
+  const double moved = (*turned.at(first.target_utime) - first.position).norm();
+  EXPECT_GT(moved, 0.030);
+  const std::string expected = "re-planned (request " + std::to_string(first.sequence) +
+                               "): the ball at T moved ";
+  EXPECT_EQ(rig.status().message.rfind(expected, 0), 0u) << rig.status().message;
+  EXPECT_EQ(rig.status().state, GraspState::kGrasping);
+  EXPECT_EQ(rig.machine.replans(), 1u);
+  rig.advance(0.6);
+  rig.executed(first);  // the driver ran its motion; its CLOSE gave way
+  rig.arm.gripper = Status::GRIPPER_OPEN;
+  rig.publish();
+  EXPECT_EQ(rig.status().state, GraspState::kGrasping);
+  rig.advance(0.8);
+  rig.executed(*again);
+  EXPECT_EQ(rig.status().state, GraspState::kHandClosed);
+  EXPECT_EQ(kind(rig.take()), Req::kMove);  // the lift
+}
+
+// No re-plan from a newer forecast that agrees with the approach, nor from a turn seen once the
+// CLOSE may be on the line (0.7 s after the approach, past 0.78 - 0.15 s), nor from the same
+// trajectory again.
+TEST(GraspMachineTest, NoReplanWhenTheForecastAgreesOrTheCloseMayHaveGone) {
+  Rig rig;
+  approach_in_flight(rig);
+  rig.advance(0.25);
+  rig.feed_with_sigma(0.001);
+  EXPECT_EQ(kind(rig.take()), Req::kNone) << rig.status().message;
+  rig.advance(0.45);
+  rig.machine.on_trajectory(turned_path(rig.now), rig.now - 50'000, rig.now);
+  EXPECT_EQ(kind(rig.take()), Req::kNone) << rig.status().message;
+  EXPECT_EQ(rig.machine.replans(), 0u);
+  EXPECT_EQ(rig.status().state, GraspState::kGrasping);
+}
+
+// A forecast that no longer makes the close sure (2 sigma of 0.02 m per axis at T) re-plans the
+// approach into tracking above the ball, back in q1 and waiting to close.
+TEST(GraspMachineTest, DoubtAfterTheApproachBeganReturnsToWaiting) {
+  Rig rig;
+  const ArmRequest first = approach_in_flight(rig);
+  rig.advance(0.25);
+  rig.feed_with_sigma(0.02);
+
+  const std::optional<ArmRequest> wait = rig.take();
+
+  ASSERT_EQ(kind(wait), Req::kMove) << rig.status().message;
+  EXPECT_NEAR(wait->position.z(), 0.10 + rig.settings.standoff, 0.002);
+  EXPECT_EQ(rig.status().state, GraspState::kApproaching);
+  const std::string expected = "re-planned (request " + std::to_string(first.sequence) +
+                               "): at T 2.0 sigma 69.";
+  EXPECT_EQ(rig.status().message.rfind(expected, 0), 0u) << rig.status().message;
+  EXPECT_NE(rig.status().message.find("; waiting to close: 2.0 sigma 69."), std::string::npos)
+      << rig.status().message;
+}
+
+// A re-plan that came too late: the first approach's CLOSE went out and the hand is reported
+// closed when the re-planned tracking move is executed. q1 opens the hand (a0) before it
+// approaches again.
+TEST(GraspMachineTest, ReplanTooLateOpensTheHandBeforeTheNextApproach) {
+  Rig rig;
+  const ArmRequest first = approach_in_flight(rig);
+  rig.advance(0.25);
+  rig.feed_with_sigma(0.02);
+  const std::optional<ArmRequest> wait = rig.take();
+  ASSERT_EQ(kind(wait), Req::kMove) << rig.status().message;
+  rig.advance(0.6);
+  rig.executed(first);  // with its CLOSE: gripper CLOSED
+  rig.advance(0.8);
+  rig.executed(*wait);
+  ASSERT_EQ(rig.arm.gripper, Status::GRIPPER_CLOSED);
+  rig.feed_with_sigma(0.001);
+
+  const std::optional<ArmRequest> open = rig.take();
+
+  EXPECT_EQ(kind(open), Req::kOpen) << rig.status().message;
+  EXPECT_EQ(rig.status().state, GraspState::kApproaching);
+  rig.advance(0.8);
+  rig.executed(*open);
+  rig.feed_with_sigma(0.001);
+  EXPECT_EQ(kind(rig.take()), Req::kApproach) << rig.status().message;
+}
+
+// Re-plans are bounded: with a turn in every trajectory (the ball reverses every 0.25 s), at
+// most max_replans (3) a grasp; then the approach in flight stands.
+TEST(GraspMachineTest, ReplansAreBoundedPerGrasp) {
+  Rig rig;
+  approach_in_flight(rig);
+  bool turned = false;
+  for (int i = 0; i < 6; ++i) {
+    rig.advance(0.25);
+    turned = !turned;
+    rig.machine.on_trajectory(turned ? turned_path(rig.now) : circle_path(rig.now),
+                              rig.now - 50'000, rig.now);
+    const std::optional<ArmRequest> r = rig.take();
+    EXPECT_EQ(kind(r), i < 3 ? Req::kApproach : Req::kNone) << i << ": " << rig.status().message;
+  }
+  EXPECT_EQ(rig.machine.replans(), 3u);
+}
+
 // After the lift, the ball measured far from the tool for judge_time means the grasp failed; the
 // message gives the nearest distance seen.
 TEST(GraspMachineTest, FullGraspFailsWhenTheBallIsNotAtTheTool) {
