@@ -14,6 +14,7 @@
 //   build/bin/grasp_success --no-render --trials 500 --verbose
 //   build/bin/grasp_success --occluded-fraction 0  # no occlusion
 //   build/bin/grasp_success --kalman               # the Kalman predictor's mode too
+//   build/bin/grasp_success --no-replan            # approaches once sent stand (the rule's effect)
 //   build/bin/grasp_success --no-render --kalman --sweep speed --out docs/img
 // A sweep (issue 17: "the curves no paper shows") runs --trials trials at each of its points in
 // every mode, each point with the same draws (the same seeds) but for the swept quantity, and
@@ -55,6 +56,7 @@ struct Options {
   bool only_baseline = false;  // --no-prediction: the baseline alone
   bool skip_baseline = false;
   bool kalman = false;         // --kalman: the Kalman predictor's mode too
+  bool no_replan = false;      // --no-replan: an approach once sent stands (before issue 17's rule)
   std::string sweep;           // interaction, speed or occlusion: success against it
   std::vector<double> points;  // the sweep's values (empty: its defaults)
   std::string out = ".";       // where a sweep's table, data and plot go
@@ -115,6 +117,7 @@ sg::system::TrialParams draw_trial(const Options& o, int index) {
   p.tracker.selection =
       o.selection == "largest" ? sg::vision::Selection::kLargest : sg::vision::Selection::kScored;
   p.calibration = o.cameras;
+  if (o.no_replan) p.grasp.max_replans = 0;
   return p;
 }
 
@@ -141,17 +144,17 @@ void print_trials(const Options& o, const ModeSummary& m, const Tweak& tweak) {
   std::printf("\n%s, per trial:\n", m.name);
   std::printf(
       "trial  rpm  r(m) drift  grasp_s  close_s held mach  miss_mm  aim_mm  dT_ms  age_s  "
-      "vis_mm  state / message\n");
+      "vis_mm re  state / message\n");
   for (int i = 0; i < static_cast<int>(m.results.size()); ++i) {
     auto p = draw_trial(o, index_of(o, i));
     if (tweak) tweak(p);
     const auto& r = m.results[static_cast<size_t>(i)];
     std::printf(
-        "%5d %4.2f %5.3f %5.4f %7.2f %8.2f %4s %4s %8.1f %7.1f %6.0f %6.2f %7.2f  %s / %s%s\n",
+        "%5d %4.2f %5.3f %5.4f %7.2f %8.2f %4s %4s %8.1f %7.1f %6.0f %6.2f %7.2f %2d  %s / %s%s\n",
         index_of(o, i), p.sim.scenario.rpm, p.sim.scenario.radius, p.sim.scenario.drift_speed,
         r.grasp_time, r.close_time, r.success ? "yes" : "no", sg::grasp::to_string(r.outcome),
         r.miss_distance * 1e3, r.aim_error * 1e3, r.timing_error * 1e3, r.track_age,
-        r.vision_rms * 1e3, sg::grasp::to_string(r.final_state), r.message.c_str(),
+        r.vision_rms * 1e3, r.replans, sg::grasp::to_string(r.final_state), r.message.c_str(),
         r.arm_rejection.empty() ? "" : (" [arm: " + r.arm_rejection + "]").c_str());
     if (o.only >= 0) std::printf("      approach sent: %s\n", r.approach_message.c_str());
   }
@@ -203,23 +206,27 @@ void print_table(const Options& o, const std::vector<ModeSummary>& modes) {
       o.occluded_fraction);
   std::printf(
       "\n| mode | success (held after lift) | 95%% interval | machine agrees | closed | refused | "
-      "arm refusals | miss p50 | miss p95 | miss max | run time |\n"
-      "|---|---|---|---|---|---|---|---|---|---|---|\n");
+      "arm refusals | re-plans (trials) | CLOSEs given way | miss p50 | miss p95 | miss max | "
+      "run time |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const ModeSummary& m : modes) {
-    int held = 0, agree = 0, closed = 0, refused = 0, rejected = 0;
+    int held = 0, agree = 0, closed = 0, refused = 0, rejected = 0, replans = 0, replanned = 0;
+    int given_way = 0;
     std::vector<double> miss;
     for (const auto& r : m.results) {
       held += r.success, agree += r.machine_agrees, closed += r.closed, refused += r.refused;
-      rejected += r.rejected;
+      rejected += r.rejected, replans += r.replans, replanned += r.replans > 0;
+      given_way += r.gripper_actions_dropped;
       if (r.closed) miss.push_back(r.miss_distance * 1e3);
     }
     const int n = static_cast<int>(m.results.size());
     const auto [lo, hi] = wilson(held, n);
     std::printf(
-        "| %s | %d/%d (%.0f%%) | %.1f-%.1f%% | %d/%d | %d | %d | %d | %.1f mm | %.1f mm | %.1f mm "
-        "| %.0f s |\n",
+        "| %s | %d/%d (%.0f%%) | %.1f-%.1f%% | %d/%d | %d | %d | %d | %d (%d) | %d | %.1f mm | "
+        "%.1f mm | %.1f mm | %.0f s |\n",
         m.name, held, n, 100.0 * held / n, 100 * lo, 100 * hi, agree, n, closed, refused, rejected,
-        percentile(miss, 0.5), percentile(miss, 0.95), percentile(miss, 1.0), m.seconds);
+        replans, replanned, given_way, percentile(miss, 0.5), percentile(miss, 0.95),
+        percentile(miss, 1.0), m.seconds);
   }
   std::vector<double> vision;
   double pooled_sq = 0, pooled_n = 0;
@@ -400,6 +407,8 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"interaction", "speed", "occlusion"}));
   app.add_option("--points", o.points, "the sweep's values (default: its own list)");
   app.add_option("--out", o.out, "directory for a sweep's .md, .dat, .gp and .png");
+  app.add_flag("--no-replan", o.no_replan,
+               "never re-plan an approach once sent (grasp.max_replans 0), for comparison");
   app.add_flag("--verbose", o.verbose, "per-trial diagnostics");
   app.add_option("--trial", o.only,
                  "run only this trial of the draw (0 .. trials - 1), e.g. a miss --verbose listed; "

@@ -37,6 +37,14 @@ GraspSettings read_grasp_settings(const Config& config) {
            "s: the 1-sigma spread of the controller's delay per interaction");
   g.number("max_wait", s.max_wait, Range::closed(0, 600),
            "s after the grasp command: close on the best guess when no interception was sure");
+  g.number("replan_shift", s.replan_shift, Range::above_to(0, 1),
+           "m: a newer forecast moving the ball at the approach's arrival time this far re-plans "
+           "the approach");
+  g.number("replan_margin", s.replan_margin, Range::closed(0, 10),
+           "s: re-plan only until one delay less this after the approach was sent (the CLOSE "
+           "can then still give way in the driver)");
+  g.number("max_replans", s.max_replans, Range::closed(0, 100),
+           "re-plans of the approach a grasp (0: never)");
   g.flag("use_prediction", s.use_prediction,
          "false: aim at the last measured position (the baseline)");
   g.number("table_z", i.table_z, Range::closed(-2, 2), "m: the table top in the robot's frame");

@@ -289,6 +289,8 @@ TrialResult Trial::finish() {
       ++result_.interactions;
   }
   result_.serial_bytes = arm_.line().bytes_written();
+  result_.replans = static_cast<int>(node_.machine().replans());
+  result_.gripper_actions_dropped = static_cast<int>(arm_.driver().gripper_actions_dropped());
   if (vision_n_ > 0) result_.vision_rms = std::sqrt(vision_sq_ / vision_n_);
   result_.vision_samples = static_cast<int64_t>(vision_n_);
   return result_;

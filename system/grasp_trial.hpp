@@ -104,6 +104,8 @@ struct TrialResult {
   int rejected = 0;                  ///< of which refused (driver's validator or controller)
   int interactions = 0;              ///< motion lines the controller received (MA, READY, ...)
   uint64_t serial_bytes = 0;         ///< bytes the driver wrote on the line
+  int replans = 0;  ///< approaches the machine re-planned (a turn seen after one began)
+  int gripper_actions_dropped = 0;  ///< CLOSEs that gave way to a newer command in the driver
   double vision_rms = std::nan("");  ///< m: 3D RMS of the measurements against the truth
   int64_t vision_samples = 0;        ///< visible measurements vision_rms is over
                                      ///< (visible frames, ball not carried)

@@ -76,6 +76,7 @@ class SimulatedArm {
   const sim::C550Controller& controller() const { return controller_; }
   const sim::C550Emulator& emulator() const { return emulator_; }
   const SimulatedLine& line() const { return line_; }
+  const arm::ArmDriver& driver() const { return driver_; }
 
  private:
   SimulatedClock& clock_;
