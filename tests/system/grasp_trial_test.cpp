@@ -113,5 +113,27 @@ TEST(GraspTrial, CommandsCrossTheSerialLine) {
   EXPECT_GT(r.serial_bytes, 30u * static_cast<uint64_t>(r.interactions));
 }
 
+// A drift turn seen after the approach began (1.6 rpm, r = 0.112 m, closing at 48.8 s) is
+// re-planned and held; the same draw without re-planning closes on the old forecast and misses.
+TEST(GraspTrial, TurnAfterTheApproachIsReplannedAndHeld) {
+  TrialParams p = quick_trial();
+  p.sim.scenario.rpm = 1.6;
+  p.sim.scenario.radius = 0.112;
+  p.sim.scenario.drift_speed = 0.0099;
+  p.sim.occlusion.episodes.clear();
+  p.grasp_time = 48.8;
+  const TrialResult replanned = run_grasp_trial(p);
+  EXPECT_TRUE(replanned.success) << replanned.message;
+  EXPECT_GE(replanned.replans, 1);
+  EXPECT_GE(replanned.gripper_actions_dropped, 1);
+  EXPECT_LT(replanned.miss_distance, 0.02);
+
+  p.grasp.max_replans = 0;
+  const TrialResult blind = run_grasp_trial(p);
+  EXPECT_FALSE(blind.success);
+  EXPECT_EQ(blind.replans, 0);
+  EXPECT_GT(blind.miss_distance, 0.02);
+}
+
 }  // namespace
 }  // namespace sg::system
