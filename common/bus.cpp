@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "common/clock.hpp"
 #include "common/log_format.hpp"
 #include "common/shutdown.hpp"
 
@@ -104,6 +105,7 @@ class Bus::RawHandler {
   void handleMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel) noexcept {
     try {
       ++bus_.messages_received_;
+      bus_.rates_.received(channel);
       RawMessage raw;
       raw.info.channel = channel;
       raw.info.recv_utime = rbuf->recv_utime;
@@ -139,10 +141,21 @@ Bus::Bus(const std::string& url) : url_(url) {
   }
 }
 
-Bus::~Bus() = default;
+Bus::~Bus() {
+  // A last word: a process that exits says so, so a watcher tells a stop from a crash.
+  if (process_.empty() || state_ == stereograsp::process_status_t::STATE_STOPPING) return;
+  try {
+    set_state(stereograsp::process_status_t::STATE_STOPPING,
+              shutdown_requested() ? "asked to stop" : "exiting");
+  } catch (...) {  // nothing may leave a destructor
+  }
+}
 
 bool Bus::publish_raw(const std::string& channel, const void* data, int size) {
-  if (lcm_->publish(channel, data, static_cast<unsigned>(size)) == 0) return true;
+  if (lcm_->publish(channel, data, static_cast<unsigned>(size)) == 0) {
+    rates_.sent(channel);
+    return true;
+  }
   ++publish_errors_;
   spdlog::warn("publish on {} failed ({} bytes): {}", channel, size, std::strerror(errno));
   return false;
@@ -179,6 +192,8 @@ bool Bus::handle(std::chrono::milliseconds timeout) {
 
 void Bus::spin(const std::function<bool()>& keep_going, std::chrono::milliseconds poll) {
   while (!shutdown_requested() && keep_going() && !end_of_log_) handle(poll);
+  if (shutdown_requested() && !process_.empty())
+    set_state(stereograsp::process_status_t::STATE_STOPPING, "asked to stop");
 }
 
 void Bus::note_problem(uint64_t count, const std::string& line) {
@@ -199,15 +214,34 @@ void Bus::note_refused(const std::string& channel, const std::string& why) {
   note_problem(++refused_inputs_, channel + ": refused: " + why);
 }
 
-void Bus::announce(const std::string& process) {
+void Bus::announce(const std::string& process, int8_t state, const std::string& detail) {
+  const bool first = process_.empty();
   process_ = process;
   char name[256] = {};
   host_ = gethostname(name, sizeof name - 1) == 0 ? name : "?";
+  state_ = state;
+  state_detail_ = detail;
+  if (first) {
+    start_utime_ = now_utime();
+    clock_sync_ = std::make_unique<ClockSync>(process_ + "@" + host_ + ":" +
+                                              std::to_string(static_cast<int32_t>(getpid())));
+    subscribe<stereograsp::process_status_t>(
+        "PROCESS_STATUS", [this](const stereograsp::process_status_t& s, const ReceiveInfo& info) {
+          clock_sync_->receive(s, info.recv_utime);
+        });
+  }
   next_status_ = {};
   tick();
 }
 
-stereograsp::process_status_t Bus::process_status(int64_t utime) const {
+void Bus::set_state(int8_t state, const std::string& detail) {
+  if (state == state_ && detail == state_detail_) return;
+  state_ = state;
+  state_detail_ = detail;
+  if (!process_.empty()) publish_status();
+}
+
+stereograsp::process_status_t Bus::process_status(int64_t utime) {
   stereograsp::process_status_t s{};
   s.utime = utime;
   s.process = process_;
@@ -221,6 +255,14 @@ stereograsp::process_status_t Bus::process_status(int64_t utime) const {
   s.last_problem = last_problem_.substr(0, 1000);
   s.last_problem.erase(std::find(s.last_problem.begin(), s.last_problem.end(), '\0'),
                        s.last_problem.end());  // a channel name may hold anything
+  s.state = state_;
+  s.state_detail = state_detail_.substr(0, 1000);
+  s.start_utime = start_utime_;
+  rates_.fill(
+      s,
+      std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count());
+  for (std::string& c : s.channel) c.erase(std::find(c.begin(), c.end(), '\0'), c.end());
+  if (clock_sync_) clock_sync_->fill(s);
   return s;
 }
 
@@ -228,11 +270,12 @@ void Bus::tick() {
   if (process_.empty()) return;
   const auto now = std::chrono::steady_clock::now();
   if (now < next_status_) return;
-  next_status_ = now + std::chrono::seconds(1);
-  const auto utime = std::chrono::duration_cast<std::chrono::microseconds>(
-                         std::chrono::system_clock::now().time_since_epoch())
-                         .count();
-  publish("PROCESS_STATUS", process_status(utime));
+  publish_status();
+}
+
+void Bus::publish_status() {
+  next_status_ = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+  publish("PROCESS_STATUS", process_status(now_utime()));
 }
 
 }  // namespace sg

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "common/channel_rates.hpp"
+#include "common/clock_sync.hpp"
 #include "common/safe_decode.hpp"
 #include "stereograsp/process_status_t.hpp"
 
@@ -132,8 +134,19 @@ class Bus {
   bool end_of_log() const { return end_of_log_; }
 
   /// Publishes a process_status_t on PROCESS_STATUS now and then once a second (from handle()
-  /// and spin()), for `process` (the program's name).
-  void announce(const std::string& process);
+  /// and spin()), for `process` (the program's name), in state `state` (STATE_READY: a program
+  /// announces once it serves; STATE_STARTING while it waits for something, set_state() when
+  /// that comes). From then on the bus also listens to PROCESS_STATUS and echoes the other
+  /// processes' statuses in its own, so each measures its clock's offset to the others
+  /// (sg::ClockSync, docs/lab.md). The last status, from spin() when a shutdown was requested or
+  /// else from the destructor, is STATE_STOPPING: a watcher tells a process that stopped from one
+  /// that died.
+  void announce(const std::string& process,
+                int8_t state = stereograsp::process_status_t::STATE_READY,
+                const std::string& detail = "");
+
+  /// Changes the state PROCESS_STATUS reports, and publishes it at once when it changed.
+  void set_state(int8_t state, const std::string& detail = "");
 
   /// Publishes PROCESS_STATUS if a second has passed since the last one (after announce()).
   /// handle() and spin() call it; a program that polls LCM's file descriptor itself and calls
@@ -151,8 +164,12 @@ class Bus {
   uint64_t publish_errors() const { return publish_errors_; }
   /// The newest refusal or failure, one line ("" when none).
   const std::string& last_problem() const { return last_problem_; }
-  /// The counts as PROCESS_STATUS carries them (process and host as announce()d).
-  stereograsp::process_status_t process_status(int64_t utime) const;
+  /// The status PROCESS_STATUS carries at `utime`: counts, state, per-channel counts and rates
+  /// (since the previous call), and the clock echoes (process and host as announce()d).
+  stereograsp::process_status_t process_status(int64_t utime);
+
+  /// Clock offsets to the other announced processes (empty before announce()).
+  const ClockSync* clock_sync() const { return clock_sync_.get(); }
 
   /// The underlying LCM object, for what this wrapper does not cover.
   lcm::LCM& lcm() { return *lcm_; }
@@ -176,6 +193,12 @@ class Bus {
   uint64_t publish_errors_ = 0;
   std::string last_problem_;
   std::string process_, host_;  // as announce()d; "" = no PROCESS_STATUS
+  int8_t state_ = stereograsp::process_status_t::STATE_READY;
+  std::string state_detail_;
+  int64_t start_utime_ = 0;
+  ChannelRates rates_;
+  std::unique_ptr<ClockSync> clock_sync_;
+  void publish_status();
   std::chrono::steady_clock::time_point next_status_{};
   bool end_of_log_ = false;
 };

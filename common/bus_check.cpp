@@ -191,6 +191,25 @@ void fill(process_status_t& m, Pattern& p) {
   m.refused_inputs = p.integer();
   m.publish_errors = p.integer();
   m.last_problem = p.text();
+  m.state = p.small();
+  m.state_detail = p.text();
+  m.start_utime = p.integer();
+  m.num_channels = p.below(5);
+  for (int32_t i = 0; i < m.num_channels; ++i) {
+    m.channel.push_back(p.text());
+    m.messages_in.push_back(p.integer());
+    m.messages_out.push_back(p.integer());
+    m.rate_in_hz.push_back(p.real());
+    m.rate_out_hz.push_back(p.real());
+  }
+  m.num_peers = p.below(5);
+  for (int32_t i = 0; i < m.num_peers; ++i) {
+    m.peer.push_back(p.text());
+    m.peer_utime.push_back(p.integer());
+    m.peer_recv_utime.push_back(p.integer());
+    m.peer_offset_us.push_back(p.integer());
+    m.peer_offset_error_us.push_back(p.integer());
+  }
 }
 
 template <class T>
@@ -233,7 +252,8 @@ class TypicalFiller {
     } else {
       value.resize(kTypicalArray);
       for (auto& element : value) {
-        if constexpr (std::is_arithmetic_v<typename T::value_type>) {
+        if constexpr (std::is_arithmetic_v<typename T::value_type> ||
+                      std::is_same_v<typename T::value_type, std::string>) {
           add(name, element);
         } else {
           element.resize(static_cast<size_t>(inner(name)));

@@ -96,7 +96,11 @@ template <class M, class V>
 void visit_fields(M& m, V& v) {
   SG_FIELD(utime); SG_FIELD(process); SG_FIELD(host); SG_FIELD(pid);
   SG_FIELD(messages_received); SG_FIELD(decode_errors); SG_FIELD(handler_errors);
-  SG_FIELD(refused_inputs); SG_FIELD(publish_errors); SG_FIELD(last_problem);
+  SG_FIELD(refused_inputs); SG_FIELD(publish_errors); SG_FIELD(last_problem); SG_FIELD(state);
+  SG_FIELD(state_detail); SG_FIELD(start_utime); SG_FIELD(num_channels); SG_FIELD(channel);
+  SG_FIELD(messages_in); SG_FIELD(messages_out); SG_FIELD(rate_in_hz); SG_FIELD(rate_out_hz);
+  SG_FIELD(num_peers); SG_FIELD(peer); SG_FIELD(peer_utime); SG_FIELD(peer_recv_utime);
+  SG_FIELD(peer_offset_us); SG_FIELD(peer_offset_error_us);
 }
 
 // clang-format on

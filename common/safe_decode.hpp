@@ -60,6 +60,18 @@ struct WireLimits<stereograsp::trajectory_t> {
   }
 };
 template <>
+struct WireLimits<stereograsp::process_status_t> {
+  static constexpr int64_t kMaxString = 4096;
+  /// The channels and peers a status lists are capped at 64 by sg::Bus (ProcessHealth).
+  static std::vector<VariableArray> arrays() {
+    return {{"channel", "num_channels", 64, 1},      {"messages_in", "num_channels", 64, 1},
+            {"messages_out", "num_channels", 64, 1}, {"rate_in_hz", "num_channels", 64, 1},
+            {"rate_out_hz", "num_channels", 64, 1},  {"peer", "num_peers", 64, 1},
+            {"peer_utime", "num_peers", 64, 1},      {"peer_recv_utime", "num_peers", 64, 1},
+            {"peer_offset_us", "num_peers", 64, 1},  {"peer_offset_error_us", "num_peers", 64, 1}};
+  }
+};
+template <>
 struct WireLimits<stereograsp::image_t> {
   static constexpr int64_t kMaxString = 4096;
   /// 64 MiB: a 4096 x 4096 RGB frame is 48 MiB.
@@ -176,14 +188,18 @@ class Walker {
       return fail(name, "claims " + std::to_string(*count) + " entries (" + spec->length_field +
                             "), must be 0.." + std::to_string(spec->max_length));
     }
-    int element_size = 0;
-    if constexpr (std::is_arithmetic_v<Element>) {
-      element_size = scalar_size<Element>();
+    if constexpr (std::is_same_v<Element, std::string>) {  // each string checked as a field
+      for (int64_t i = 0; i < *count && error_.empty(); ++i) string_field(name);
     } else {
-      static_assert(std::is_arithmetic_v<typename Element::value_type>, "nested too deep");
-      element_size = scalar_size<typename Element::value_type>();
+      int element_size = 0;
+      if constexpr (std::is_arithmetic_v<Element>) {
+        element_size = scalar_size<Element>();
+      } else {
+        static_assert(std::is_arithmetic_v<typename Element::value_type>, "nested too deep");
+        element_size = scalar_size<typename Element::value_type>();
+      }
+      take(name, *count * spec->inner * element_size, "the array");
     }
-    take(name, *count * spec->inner * element_size, "the array");
   }
 
   const VariableArray* find_spec(const char* name) {

@@ -14,8 +14,17 @@
 // random bodies behind the type's fingerprint, every truncation, and the other types' messages
 // (common/bus_check.hpp). Every process must survive it, within its memory, and the arm must not
 // move (scripts/hostile_bus.sh, docs/reliability.md).
+//
+//   sg-bus-check health [--duration 3] [--watch]                    # issue 18: who is there
+//
+// `health` listens to PROCESS_STATUS, takes part in the clock exchange, and prints every process
+// with its host, state, uptime, rates and bad messages, every host's clock offset to this one,
+// and a warning for each host whose clock is off by more than the loop tolerates (exit 1 then).
+// With --watch it runs until interrupted and prints, as they happen, the processes that join,
+// stop beating (2.5 s silent), come back or stop, and the clock warnings.
 
 #include <spdlog/spdlog.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -33,6 +42,7 @@
 #include "common/bus.hpp"
 #include "common/bus_check.hpp"
 #include "common/clock.hpp"
+#include "common/process_watch.hpp"
 #include "common/program.hpp"
 #include "common/shutdown.hpp"
 #include "logger/log_reader.hpp"
@@ -244,6 +254,53 @@ int run_hostile(sg::Bus& bus, sg::bus_check::HostilePlan& plan, const HostileOpt
   return bus.publish_errors() == 0 ? 0 : 1;
 }
 
+struct HealthOptions {
+  double duration_s = 3.0;
+  bool watch = false;
+};
+
+/// `health`: the process table and clock offsets after `duration_s`, or (--watch) the events as
+/// they come. Exit 1 when a clock is off by more than the loop tolerates or a process is silent.
+int run_health(sg::Bus& bus, const HealthOptions& o) {
+  sg::ProcessWatch watch;
+  bus.subscribe<stereograsp::process_status_t>(
+      "PROCESS_STATUS", [&](const stereograsp::process_status_t& s, const sg::ReceiveInfo& info) {
+        watch.receive(s, info.recv_utime);
+      });
+  bus.announce("sg-bus-check");
+  char name[256] = {};
+  const std::string self_host = gethostname(name, sizeof name - 1) == 0 ? name : "?";
+  const auto end = steady_clock::now() + duration<double>(o.duration_s);
+  std::set<std::string> warned;
+  bool trouble = false;
+  bus.spin([&] {
+    if (!o.watch) return steady_clock::now() < end;
+    for (const auto& e : watch.check(sg::now_utime())) {
+      std::printf("%s\n", e.line.c_str());
+      trouble |= e.kind == sg::ProcessWatch::Event::kStoppedBeating;
+    }
+    for (const auto& w : sg::clock_warnings(watch.host_offsets(self_host), self_host)) {
+      if (warned.insert(w.substr(0, w.find(" is "))).second)
+        std::printf("warning: %s\n", w.c_str());
+      trouble = true;
+    }
+    std::fflush(stdout);
+    return true;
+  });
+  if (o.watch) return trouble ? 1 : 0;
+  const int64_t now = sg::now_utime();
+  watch.check(now);
+  const auto offsets = watch.host_offsets(self_host);
+  std::printf("%s\n%s", sg::format_processes(watch, now).c_str(),
+              sg::format_clocks(offsets, self_host).c_str());
+  for (const auto& w : sg::clock_warnings(offsets, self_host)) {
+    std::printf("warning: %s\n", w.c_str());
+    trouble = true;
+  }
+  for (const auto& p : watch.processes()) trouble |= p.silent;
+  return trouble ? 1 : 0;
+}
+
 void add_hostile_options(CLI::App& cmd, HostileOptions& o) {
   cmd.add_option("--rate", o.rate_hz, "packets per second (not a flood)")
       ->check(CLI::Range(1.0, 1e6))
@@ -300,9 +357,24 @@ int main(int argc, char** argv) {
       "hostile", "Publish hostile packets of every type on the channels the system reads");
   add_hostile_options(*hostile_cmd, hostile);
 
+  HealthOptions health;
+  CLI::App* health_cmd = app.add_subcommand(
+      "health", "Show every process on the bus (PROCESS_STATUS) and the hosts' clock offsets");
+  health_cmd->add_option("--duration", health.duration_s, "seconds to listen before the table")
+      ->check(CLI::Range(0.5, 3600.0))
+      ->capture_default_str();
+  health_cmd->add_flag("--watch", health.watch,
+                       "run until interrupted, printing processes that join, stop beating, come "
+                       "back or stop, and clock warnings");
+
   return sg::run_program(app, argc, argv, [&] {
     const sg::Config config = sg::load_common(common);
     if (*verify_cmd) return run_verify_log(log_path, log_count);
+    if (*health_cmd) {
+      sg::install_shutdown_handlers();
+      sg::Bus bus(common.lcm_url);
+      return run_health(bus, health);
+    }
     if (*hostile_cmd) {
       sg::bus_check::HostilePlan plan =
           sg::bus_check::plan_attack(hostile.channels, hostile.settings);

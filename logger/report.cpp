@@ -243,6 +243,31 @@ Json j_grasp(const GraspSummary& g) {
           {"events", events}};
 }
 
+/// report.json's "processes": who published PROCESS_STATUS, their stops and silences, clocks.
+Json j_processes(const ProcessesSummary& p) {
+  Json processes = Json::array();
+  for (const ProcessSummary& s : p.processes)
+    processes.push_back({{"name", s.name},
+                         {"host", s.host},
+                         {"first_s", s.first_s},
+                         {"last_s", s.last_s},
+                         {"last_state", s.last_state},
+                         {"bad", s.bad},
+                         {"last_problem", s.last_problem}});
+  Json clocks = Json::array();
+  for (const ProcessWatch::HostOffset& h : p.clocks)
+    clocks.push_back({{"host", h.host},
+                      {"known", h.known},
+                      {"offset_us", h.offset_us},
+                      {"error_us", h.error_us}});
+  return {{"processes", processes},
+          {"events", p.events},
+          {"event_count", p.event_count},
+          {"clock_reference", p.clock_reference},
+          {"clocks", clocks},
+          {"clock_warnings", p.clock_warnings}};
+}
+
 }  // namespace
 
 std::string report_json(const SessionSummary& s) {
@@ -262,6 +287,7 @@ std::string report_json(const SessionSummary& s) {
   j["occlusions"] = j_occlusions(s.occlusions);
   j["arm"] = j_arm(s.arm);
   j["grasp"] = j_grasp(s.grasp);
+  j["processes"] = j_processes(s.processes);
   return j.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
 }
 
@@ -316,9 +342,43 @@ void md_problems(std::ostream& o, const SessionSummary& s) {
       << (u.fingerprint.empty() ? "(too short)" : u.fingerprint) << "\n";
     any = true;
   }
+  for (const std::string& w : s.processes.clock_warnings) {
+    o << "- " << w << "\n";
+    any = true;
+  }
+  for (const std::string& e : s.processes.events) {
+    if (e.find("stopped beating") == std::string::npos) continue;
+    o << "- " << e << "\n";
+    any = true;
+  }
   if (!any) o << "None.\n";
   for (const UnknownChannel& u : s.lcm_internal)
     o << "\nLCM's own: " << u.name << " (" << u.count << " message(s); normal on udpm).\n";
+}
+
+/// "Processes" (when any published PROCESS_STATUS): a row per process, the stops and silences,
+/// and every host's clock against the reference host's.
+void md_processes(std::ostream& o, const ProcessesSummary& p) {
+  if (p.processes.empty()) return;
+  o << "\n## Processes\n\n"
+    << "| process | host | first s | last s | last state | bad messages | last problem |\n"
+       "|---|---|---:|---:|---|---:|---|\n";
+  for (const ProcessSummary& s : p.processes)
+    o << "| " << md_cell(s.name) << " | " << md_cell(s.host) << " | " << num(s.first_s, 1) << " | "
+      << num(s.last_s, 1) << " | " << s.last_state << " | " << s.bad << " | "
+      << md_cell(s.last_problem) << " |\n";
+  if (!p.events.empty()) {
+    o << "\n";
+    for (const std::string& e : p.events) o << "- " << md_cell(e) << "\n";
+    if (p.event_count > static_cast<int64_t>(p.events.size()))
+      o << "- ... and " << (p.event_count - static_cast<int64_t>(p.events.size())) << " more\n";
+  }
+  o << "\nClocks, as the processes measured them from their heartbeats (NTP-style; docs/lab.md), "
+       "against "
+    << md_cell(p.clock_reference) << "'s:\n\n| host | offset ms | ± ms |\n|---|---:|---:|\n";
+  for (const ProcessWatch::HostOffset& h : p.clocks)
+    o << "| " << md_cell(h.host) << " | " << (h.known ? num(h.offset_us / 1e3, 1) : "unknown")
+      << " | " << (h.known ? num(h.error_us / 1e3, 1) : "–") << " |\n";
 }
 
 /// "Channels": one row per channel with its type, count, rate, period, gaps and decoded count.
@@ -489,6 +549,7 @@ std::string report_markdown(const SessionSummary& s, const std::vector<std::stri
   std::ostringstream o;
   md_header(o, s);
   md_problems(o, s);
+  md_processes(o, s.processes);
   md_channels(o, s.channels);
   md_cameras(o, s.cameras);
   md_triangulation(o, s.triangulation);
@@ -517,6 +578,12 @@ std::string summary_text(const SessionSummary& s) {
   if (s.wrong_type > 0) o << "problem: " << s.wrong_type << " message(s) of the wrong type\n";
   for (const UnknownChannel& u : s.unknown)
     o << "unknown channel: " << u.name << " (" << u.count << ")\n";
+  for (const std::string& w : s.processes.clock_warnings) o << "problem: " << w << "\n";
+  for (const std::string& e : s.processes.events)
+    if (e.find("stopped beating") != std::string::npos) o << "problem: " << e << "\n";
+  if (!s.processes.processes.empty())
+    o << "processes: " << s.processes.processes.size() << " on " << s.processes.clocks.size()
+      << " host(s)\n";
   const TriangulationSummary& t = s.triangulation;
   if (t.visible > 0) o << "triangulation: residual p50 " << num(t.residual_px.p50, 3) << " px";
   if (t.visible > 0 && t.vs_truth_m.count > 0)

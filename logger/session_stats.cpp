@@ -16,6 +16,13 @@ using Vec3 = Eigen::Vector3d;
 
 double seconds(int64_t us) { return static_cast<double>(us) * 1e-6; }
 
+/// "12.3": seconds with one decimal.
+std::string num(double v, int decimals) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*f", decimals, v);
+  return text;
+}
+
 std::string hex64(uint64_t v) {
   char text[19];
   std::snprintf(text, sizeof(text), "0x%016llx", static_cast<unsigned long long>(v));
@@ -200,6 +207,7 @@ std::string expected_type_of_channel(const std::string& c) {
   if (c == "GRASP_COMMAND") return "grasp_command_t";
   if (c == "GRASP_STATUS") return "grasp_status_t";
   if (c == "SIM_ARM_STATE") return "sim_arm_state_t";
+  if (c == "PROCESS_STATUS") return "process_status_t";
   const std::string prefix = "BUS_CHECK_";
   if (c.rfind(prefix, 0) == 0) {
     std::string rest = c.substr(prefix.size());
@@ -284,6 +292,9 @@ struct SessionStats::Impl {
   bool started = false;
   int64_t first = 0, last = 0, events = 0;
   std::map<std::string, ChannelState> channels;
+  ProcessWatch watch;  // PROCESS_STATUS, on the log's receive times
+  ProcessesSummary processes;
+  int64_t next_watch_check = 0;
   std::map<std::string, UnknownChannel> unknown, internal;
   std::map<std::string, CameraState> cameras;
   std::map<std::string, LatencyState> latency;
@@ -660,8 +671,41 @@ struct SessionStats::Impl {
     latency_of(channel, "utime", recv, msg.utime);
     if (channel == "SIM_ARM_STATE") phases.on_sim_arm_state(recv, msg.holding_object);
   }
+  void on_message(const std::string&, int64_t recv, const stereograsp::process_status_t& msg) {
+    watch.receive(msg, recv);
+  }
   template <class T>
   void on_message(const std::string&, int64_t, const T&) {}
+
+  // The processes' stops, silences and returns up to `recv`, checked twice a second of the log.
+  void check_processes(int64_t recv, bool final = false) {
+    if (!final && recv < next_watch_check) return;
+    next_watch_check = recv + 500'000;
+    for (const ProcessWatch::Event& e : watch.check(recv)) {
+      if (e.kind == ProcessWatch::Event::kJoined) continue;
+      if (processes.events.size() < kMaxEvents)
+        processes.events.push_back(num(t(e.utime), 1) + " s: " + e.line);
+      ++processes.event_count;
+    }
+  }
+
+  // The process table and the clocks, at the end of the log.
+  void summarize_processes(ProcessesSummary& s) {
+    check_processes(last, true);
+    s = processes;
+    s.processes.clear();
+    for (const ProcessWatch::Process& p : watch.processes()) {
+      const auto& st = p.last;
+      s.processes.push_back(
+          {p.name, st.host, t(p.first_heard), t(p.last_heard), state_name(st.state),
+           st.decode_errors + st.refused_inputs + st.handler_errors, st.last_problem});
+    }
+    const ProcessWatch::Process* grasp_process = watch.find("sg-grasp");
+    const auto hosts = watch.hosts();
+    s.clock_reference = grasp_process ? grasp_process->last.host : hosts.empty() ? "" : hosts[0];
+    s.clocks = watch.host_offsets(s.clock_reference);
+    s.clock_warnings = clock_warnings(s.clocks, s.clock_reference);
+  }
 
   // The session's span and event count; its first event sets t0.
   void count_event(int64_t recv) {
@@ -839,6 +883,7 @@ void SessionStats::add(const std::string& channel, int64_t recv, const uint8_t* 
   Impl& m = *impl_;
   m.count_event(recv);
   m.phases.advance(recv);
+  m.check_processes(recv);
   add_event(channel, recv, data, size, offset);
   m.follow_phase(recv);
 }
@@ -915,6 +960,7 @@ void SessionStats::finish() {
   s.arm = m.arm;
   s.arm.interaction_s = quantiles(m.interaction);
   s.grasp = m.grasp;
+  m.summarize_processes(s.processes);
 }
 
 }  // namespace sg::logger

@@ -38,6 +38,7 @@
 #include <string>
 #include <vector>
 
+#include "common/process_watch.hpp"
 #include "logger/log_reader.hpp"
 #include "logger/plot_data.hpp"
 #include "logger/session_phase.hpp"
@@ -219,6 +220,27 @@ struct UnknownChannel {
   std::string fingerprint;  ///< of the first message, hex ("" when shorter than 8 bytes)
 };
 
+/// One process that published PROCESS_STATUS in the session (issue 18).
+struct ProcessSummary {
+  std::string name;  ///< "process@host:pid"
+  std::string host;
+  double first_s = 0, last_s = 0;  ///< first and last heartbeat, s from the log's start
+  std::string last_state;          ///< "ready", "stopping", ...
+  int64_t bad = 0;                 ///< refused, undecodable and failed messages, as it counted
+  std::string last_problem;
+};
+
+/// The processes and clocks of a session, from PROCESS_STATUS.
+struct ProcessesSummary {
+  std::vector<ProcessSummary> processes;
+  /// "12.3 s: sg-vision@lab1:77 stopped beating (silent 2.5 s)": stops, silences, returns.
+  std::vector<std::string> events;
+  int64_t event_count = 0;
+  std::string clock_reference;  ///< the host the offsets are to (sg-grasp's, else the first)
+  std::vector<ProcessWatch::HostOffset> clocks;
+  std::vector<std::string> clock_warnings;  ///< hosts off by more than the loop tolerates
+};
+
 /// Everything a report says.
 struct SessionSummary {
   std::string path;
@@ -241,6 +263,7 @@ struct SessionSummary {
   OcclusionSummary occlusions;
   ArmSummary arm;
   GraspSummary grasp;
+  ProcessesSummary processes;
 };
 
 /// Options of the pass.

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <thread>
 
 #include "common/message_types.hpp"
@@ -18,6 +19,11 @@ namespace {
 using namespace std::chrono_literals;
 using stereograsp::blob_t;
 using stereograsp::point3_t;
+
+std::string heard_host() {
+  char name[256] = {};
+  return gethostname(name, sizeof name - 1) == 0 ? name : "?";
+}
 
 point3_t make_point(int64_t utime, double x) {
   point3_t p{};
@@ -253,6 +259,54 @@ TEST(Bus, AnnouncedProcessPublishesItsCounts) {
   EXPECT_EQ(statuses[0].last_problem,
             "OBJECT_POSITION: refused: x = 1e300 m is outside the workspace");
   EXPECT_FALSE(statuses[0].host.empty());
+}
+
+// Two announced processes on one host echo each other's heartbeats: each measures the other's
+// clock (the same clock: offset 0) within the bound of its exchange, lists the channels it used
+// with their counts, and reports STATE_STARTING until set_state() says it is ready.
+TEST(Bus, AnnouncedProcessesMeasureEachOthersClock) {
+  ASSERT_TRUE(test::multicast_available(7971));
+  Bus a(test::test_url(7971)), b(test::test_url(7971));
+  std::vector<stereograsp::process_status_t> heard;
+  a.subscribe<stereograsp::process_status_t>(
+      "PROCESS_STATUS",
+      [&](const stereograsp::process_status_t& s, const ReceiveInfo&) { heard.push_back(s); });
+  a.announce("sg-a");
+  b.announce("sg-b", stereograsp::process_status_t::STATE_STARTING, "waiting for /dev/null");
+  b.publish("OBJECT_POSITION", make_point(1, 0.5));
+  auto known = [](const Bus& bus, const std::string& peer) {
+    const auto o = bus.clock_sync()->offset(peer);
+    return o && o->known;
+  };
+  const std::string name_a = "sg-a@" + heard_host() + ":" + std::to_string(getpid());
+  const std::string name_b = "sg-b@" + heard_host() + ":" + std::to_string(getpid());
+  ASSERT_TRUE(test::eventually(
+      [&] {
+        a.handle(10ms);
+        b.handle(10ms);
+        return known(a, name_b) && known(b, name_a);
+      },
+      10s, "both offsets measured"));
+  const auto o = *a.clock_sync()->offset(name_b);
+  EXPECT_LE(std::abs(o.offset_us), o.error_us) << "the same clock, within the exchange's bound";
+  EXPECT_LT(o.error_us, 100'000);
+  const auto from_b =
+      std::find_if(heard.rbegin(), heard.rend(), [](auto& s) { return s.process == "sg-b"; });
+  ASSERT_NE(from_b, heard.rend());
+  EXPECT_EQ(from_b->state, stereograsp::process_status_t::STATE_STARTING);
+  EXPECT_EQ(from_b->state_detail, "waiting for /dev/null");
+  const auto row = std::find(from_b->channel.begin(), from_b->channel.end(), "OBJECT_POSITION");
+  ASSERT_NE(row, from_b->channel.end());
+  EXPECT_EQ(from_b->messages_out[static_cast<size_t>(row - from_b->channel.begin())], 1);
+  b.set_state(stereograsp::process_status_t::STATE_READY);
+  ASSERT_TRUE(test::eventually(
+      a,
+      [&] {
+        return std::any_of(heard.begin(), heard.end(), [](auto& s) {
+          return s.process == "sg-b" && s.state == stereograsp::process_status_t::STATE_READY;
+        });
+      },
+      5s, "sg-b ready at once"));
 }
 
 }  // namespace

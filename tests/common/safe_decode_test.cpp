@@ -50,6 +50,21 @@ void fill_arrays(trajectory_t& t, std::mt19937_64& rng) {
   t.position.assign(static_cast<size_t>(t.num_points), std::vector<double>{1.0, -2.0, 3.5});
   t.position_sigma.assign(static_cast<size_t>(t.num_points), std::vector<double>{0.1, 0.2, 0.3});
 }
+void fill_arrays(stereograsp::process_status_t& m, std::mt19937_64& rng) {
+  m.num_channels = static_cast<int32_t>(rng() % 6);
+  m.num_peers = static_cast<int32_t>(rng() % 6);
+  const auto c = static_cast<size_t>(m.num_channels), p = static_cast<size_t>(m.num_peers);
+  m.channel.assign(c, "OBJECT_POSITION");
+  m.messages_in.assign(c, static_cast<int64_t>(rng()));
+  m.messages_out.assign(c, static_cast<int64_t>(rng()));
+  m.rate_in_hz.assign(c, 4.0);
+  m.rate_out_hz.assign(c, -0.5);
+  m.peer.assign(p, "sg-vision@lab1:" + std::to_string(rng() % 99999));
+  m.peer_utime.assign(p, static_cast<int64_t>(rng()));
+  m.peer_recv_utime.assign(p, static_cast<int64_t>(rng()));
+  m.peer_offset_us.assign(p, static_cast<int64_t>(rng()));
+  m.peer_offset_error_us.assign(p, -1);
+}
 void fill_arrays(image_t& m, std::mt19937_64& rng) {
   m.size = static_cast<int32_t>(rng() % 300);
   m.data.assign(static_cast<size_t>(m.size), static_cast<uint8_t>(rng()));

@@ -13,6 +13,7 @@
 
 #include "common/message_types.hpp"
 #include "logger/log_reader.hpp"
+#include "logger/report.hpp"
 #include "tests/support/subprocess.hpp"
 
 namespace sg::logger {
@@ -313,6 +314,60 @@ TEST_F(SessionStatsTest, GraspEvents) {
   EXPECT_EQ(g.success, 1);
   EXPECT_EQ(g.failed, 0);
   EXPECT_EQ(stats_->plot_data().events.size(), 6u);
+}
+
+// PROCESS_STATUS: each process listed, a host whose clock is 800 ms off sg-grasp's is a problem,
+// a process that stopped beating is reported at the time it fell silent, a clean stop is not.
+TEST(SessionStatsProcesses, ClocksAndSilencesFromTheHeartbeats) {
+  using stereograsp::process_status_t;
+  SessionStats stats;
+  auto beat = [&](const std::string& process, const std::string& host, int32_t pid, int64_t recv,
+                  int8_t state = process_status_t::STATE_READY) {
+    process_status_t s{};
+    s.utime = recv;
+    s.process = process;
+    s.host = host;
+    s.pid = pid;
+    s.state = state;
+    if (process == "sg-grasp") {  // it measured lab1's clock 800 ms behind its own
+      s.num_peers = 1;
+      s.peer = {"sg-vision@lab1:7"};
+      s.peer_utime = s.peer_recv_utime = {0};
+      s.peer_offset_us = {-800'000};
+      s.peer_offset_error_us = {300};
+    }
+    const std::vector<uint8_t> bytes = encode_message(s);
+    stats.add("PROCESS_STATUS", recv, bytes.data(), static_cast<int>(bytes.size()));
+  };
+  const int64_t t0 = 1'700'000'000'000'000;
+  for (int k = 0; k <= 10; ++k) {
+    const int64_t t = t0 + k * 1'000'000;
+    beat("sg-grasp", "lab2", 9, t);
+    if (k <= 4) beat("sg-vision", "lab1", 7, t + 1000);  // silent after 4 s
+    if (k <= 6)
+      beat("sg-predictor", "lab2", 8, t + 2000,
+           k == 6 ? process_status_t::STATE_STOPPING : process_status_t::STATE_READY);
+  }
+  stats.finish();
+  const ProcessesSummary& p = stats.summary().processes;
+  ASSERT_EQ(p.processes.size(), 3u);
+  EXPECT_EQ(p.processes[1].name, "sg-vision@lab1:7");
+  EXPECT_NEAR(p.processes[1].last_s, 4.0, 1e-2);
+  EXPECT_EQ(p.processes[2].last_state, "stopping");
+  EXPECT_EQ(p.clock_reference, "lab2");
+  ASSERT_EQ(p.clock_warnings.size(), 1u);
+  EXPECT_NE(p.clock_warnings[0].find("clock of host lab1 is -800.0 ms off lab2's"),
+            std::string::npos)
+      << p.clock_warnings[0];
+  ASSERT_EQ(p.events.size(), 2u);
+  EXPECT_EQ(p.events[0], "6.0 s: sg-predictor@lab2:8 stopped");
+  EXPECT_NE(p.events[1].find("sg-vision@lab1:7 stopped beating"), std::string::npos) << p.events[1];
+  // Its last beat at 4.0 s; reported 2.5 s later at the log's next event after a check.
+  EXPECT_GE(std::stod(p.events[1]), 6.5);
+  EXPECT_LE(std::stod(p.events[1]), 7.0);
+  const std::string md = report_markdown(stats.summary(), {});
+  EXPECT_NE(md.find("- clock of host lab1"), std::string::npos);
+  EXPECT_NE(md.find("## Processes"), std::string::npos);
 }
 
 // A histogram's percentiles: the bin's upper edge, within 12.2 % at 20 bins a decade.

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -89,6 +90,25 @@ inline void make_consistent(stereograsp::trajectory_t& m) {
   m.num_points = static_cast<int32_t>(m.position.size());
   m.position_sigma.resize(m.position.size(), std::vector<double>(3, 0.0));
   for (auto& s : m.position_sigma) s.resize(3, 0.0);
+}
+/// Channels and peers as many as num_channels and num_peers say, within the bound of 64.
+inline void make_consistent(stereograsp::process_status_t& m) {
+  m.num_channels = std::clamp<int32_t>(m.num_channels, 0, 64);
+  m.num_peers = std::clamp<int32_t>(m.num_peers, 0, 64);
+  const auto channels = static_cast<size_t>(m.num_channels);
+  const auto peers = static_cast<size_t>(m.num_peers);
+  m.channel.resize(channels);
+  for (size_t i = 0; i < channels; ++i) m.channel[i] = "SG_CHANNEL_" + std::to_string(i);
+  m.messages_in.resize(channels, 7);
+  m.messages_out.resize(channels, -1);
+  m.rate_in_hz.resize(channels, 4.0);
+  m.rate_out_hz.resize(channels, std::numeric_limits<double>::quiet_NaN());
+  m.peer.resize(peers);
+  for (size_t i = 0; i < peers; ++i) m.peer[i] = "sg-peer@host:" + std::to_string(i);
+  m.peer_utime.resize(peers, 1700000000000000);
+  m.peer_recv_utime.resize(peers, std::numeric_limits<int64_t>::min());
+  m.peer_offset_us.resize(peers, 0);
+  m.peer_offset_error_us.resize(peers, -1);
 }
 inline void make_consistent(stereograsp::blob_t& m) { m.found = m.found != 0; }
 inline void make_consistent(stereograsp::point3_t& m) { m.visible = m.visible != 0; }
