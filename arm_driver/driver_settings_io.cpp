@@ -19,6 +19,9 @@ ArmDriverSettings read_arm_driver_settings(const Config& config) {
   ArmDriverSettings s;
   Section a(config, "arm_driver");
   a.text("device", s.device, "serial device: /dev/ttyS0, /dev/ttyUSB0, or sg-c550-sim's");
+  a.number("device_wait", s.device_wait, Range::closed(0, 3600),
+           "s to wait at start for the device to appear (a C550 emulator started after the "
+           "driver, a USB adapter plugged in), 0 to refuse a missing one at once");
   a.number("baud", s.serial.baud, Range::closed(1200, 230400), "baud rate");
   std::string framing = "8N1";
   a.text("framing", framing, "data bits, parity, stop bits");

@@ -14,6 +14,9 @@ struct ArmDriverSettings {
   SerialSettings serial;
   DriverSettings driver;
   double status_rate_hz = 20;  ///< ARM_STATUS per second (also on every change)
+  /// s to wait for the device to appear at start (PROCESS_STATUS says "starting" meanwhile);
+  /// 0: refuse a missing device at once.
+  double device_wait = 0;
 };
 
 /// Reads the `arm_driver` section: every key range-checked, any other key of the section

@@ -20,9 +20,9 @@
 #include <thread>
 
 #include "arm_driver/arm_driver.hpp"
-#include "auth/lab_access.hpp"
 #include "arm_driver/driver_settings_io.hpp"
 #include "arm_driver/serial_port.hpp"
+#include "auth/lab_access.hpp"
 #include "common/bus.hpp"
 #include "common/change_or_period.hpp"
 #include "common/clock.hpp"
@@ -31,20 +31,45 @@
 
 namespace {
 
+/// Opens the device once, to fail now and clearly on a bad path; with device_wait, retries every
+/// 0.5 s for that long while PROCESS_STATUS says "starting: waiting for DEVICE". False when a
+/// shutdown came first.
+bool wait_for_device(sg::Bus& bus, const sg::arm::ArmDriverSettings& s) {
+  const auto until =
+      std::chrono::steady_clock::now() + std::chrono::duration<double>(s.device_wait);
+  bus.announce("sg-arm-driver", stereograsp::process_status_t::STATE_STARTING,
+               "opening " + s.device);
+  for (bool told = false;; told = true) {
+    try {
+      sg::arm::SerialPort::open(s.device, s.serial).reset();
+      bus.set_state(stereograsp::process_status_t::STATE_READY);
+      return true;
+    } catch (const std::exception& e) {
+      if (std::chrono::steady_clock::now() >= until) throw;
+      const std::string why = "waiting for " + s.device + ": " + e.what();
+      if (!told) spdlog::info("{} (up to {} s)", why, s.device_wait);
+      bus.set_state(stereograsp::process_status_t::STATE_STARTING, why);
+    }
+    const auto retry = std::chrono::steady_clock::now() + std::chrono::milliseconds(500);
+    while (std::chrono::steady_clock::now() < retry) {
+      if (sg::shutdown_requested()) return false;
+      bus.handle(std::chrono::milliseconds(50));
+    }
+  }
+}
+
 int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
         const sg::arm::ArmDriverSettings& s, sg::auth::LabAccess& lab) {
   sg::install_shutdown_handlers();
   sg::Bus bus(url);
-  bus.announce("sg-arm-driver");
-  sg::arm::SerialPort::open(s.device, s.serial).reset();  // fail now, clearly, on a bad path
+  if (!wait_for_device(bus, s)) return 0;  // asked to stop while waiting
   sg::arm::DriverSettings settings = s.driver;
   settings.start_utime = sg::now_utime();  // ARM_STATUS.driver_start_utime: a restart shows
   sg::arm::ArmDriver driver(geometry, settings, [&] {
     return std::unique_ptr<sg::arm::ByteStream>(sg::arm::SerialPort::open(s.device, s.serial));
   });
   bus.subscribe<stereograsp::arm_cmd_t>(
-      "ARM_COMMAND",
-      [&](const stereograsp::arm_cmd_t& command, const sg::ReceiveInfo& info) {
+      "ARM_COMMAND", [&](const stereograsp::arm_cmd_t& command, const sg::ReceiveInfo& info) {
         const std::string why = lab.refusal(info.channel, command, sg::now_utime());
         if (!why.empty()) {
           driver.refuse(command, why);
@@ -71,15 +96,17 @@ int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Drives a CRS arm through its C550 controller on a serial line: ARM_COMMAND in, "
-               "ARM_STATUS out (docs/arm.md).",
-               "sg-arm-driver"};
+  CLI::App app{
+      "Drives a CRS arm through its C550 controller on a serial line: ARM_COMMAND in, "
+      "ARM_STATUS out (docs/arm.md).",
+      "sg-arm-driver"};
   sg::CommonOptions common;
   sg::add_common_options(app, common);
   sg::auth::KeyOptions key_options;
   sg::auth::add_key_options(app, key_options);
   const auto keys = sg::declared_keys(sg::arm::read_arm_driver_settings);
   common.flags.add(app, "--device", "arm_driver.device", keys);
+  common.flags.add(app, "--device-wait", "arm_driver.device_wait", keys);
   common.flags.add(app, "--baud", "arm_driver.baud", keys);
   common.flags.add(app, "--framing", "arm_driver.framing", keys);
   common.flags.add(app, "--slave", "arm_driver.slave", keys);
