@@ -28,7 +28,17 @@ GraspNode::GraspNode(ArmGeometry geometry, GraspSettings settings, int64_t first
       machine_(std::move(geometry), std::move(settings), first_sequence),
       status_rule_(status_period) {}
 
-std::string GraspNode::on_trajectory(const stereograsp::trajectory_t& trajectory, int64_t now) {
+std::string GraspNode::on_trajectory(const stereograsp::trajectory_t& received, int64_t now) {
+  stereograsp::trajectory_t shifted;
+  const bool shift = capture_offset_ != 0;
+  if (shift) {  // onto this host's clock; a time so absurd it would overflow is left to the check
+    shifted = received;
+    for (int64_t* t : {&shifted.utime, &shifted.source_utime, &shifted.start_utime}) {
+      int64_t local = 0;
+      if (!__builtin_sub_overflow(*t, capture_offset_, &local)) *t = local;
+    }
+  }
+  const stereograsp::trajectory_t& trajectory = shift ? shifted : received;
   TrajectoryCheck c = check_trajectory(trajectory, workspace_, gate_, now);
   if (!c.path) {
     ++refused_[static_cast<size_t>(c.reason)];
@@ -58,7 +68,9 @@ std::string GraspNode::refusal_note() const {
 
 void GraspNode::on_position(const stereograsp::point3_t& m) {
   const Eigen::Vector3d p(m.position[0], m.position[1], m.position[2]);
-  machine_.on_measurement(m.visible && p.allFinite() ? std::optional(p) : std::nullopt, m.utime);
+  int64_t utime = 0;
+  if (__builtin_sub_overflow(m.utime, capture_offset_, &utime)) utime = m.utime;
+  machine_.on_measurement(m.visible && p.allFinite() ? std::optional(p) : std::nullopt, utime);
 }
 
 void GraspNode::on_arm_status(const stereograsp::arm_status_t& status, int64_t now) {

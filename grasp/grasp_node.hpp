@@ -104,6 +104,13 @@ class GraspNode {
   /// An OBJECT_POSITION: the measurement at its utime (not visible or not finite: none).
   void on_position(const stereograsp::point3_t& position);
 
+  /// The capture clock (whose times trajectories and positions carry) minus this host's clock,
+  /// µs (grasp/capture_clock.hpp): their times are put on this host's clock before anything uses
+  /// them, so a host whose clock is off does not move every interception by as much. 0 by
+  /// default (one clock).
+  void set_capture_clock_offset(int64_t offset_us) { capture_offset_ = offset_us; }
+  int64_t capture_clock_offset() const { return capture_offset_; }
+
   /// An ARM_STATUS received at `now`.
   void on_arm_status(const stereograsp::arm_status_t& status, int64_t now);
 
@@ -167,6 +174,7 @@ class GraspNode {
   bool command_changed_ = false;
   std::string last_summary_;
   std::array<uint64_t, kTrajectoryRefusals> refused_{};
+  int64_t capture_offset_ = 0;
   std::string last_refusal_;
   bool refusals_changed_ = false;
   std::string note_;                            ///< refusal_note() as last put on GRASP_STATUS

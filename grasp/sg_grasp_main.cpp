@@ -12,14 +12,18 @@
 // $SG_LAB_KEY or ~/.config/stereograsp/lab.key; docs/security.md).
 
 #include <spdlog/spdlog.h>
+#include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 
 #include "auth/lab_access.hpp"
 #include "common/bus.hpp"
 #include "common/clock.hpp"
+#include "common/process_watch.hpp"
 #include "common/program.hpp"
 #include "common/shutdown.hpp"
+#include "grasp/capture_clock.hpp"
 #include "grasp/grasp_machine.hpp"
 #include "grasp/grasp_node.hpp"
 #include "grasp/grasp_settings.hpp"
@@ -31,6 +35,43 @@
 #include "stereograsp/trajectory_t.hpp"
 
 namespace {
+
+/// Puts the forecast on this host's clock (grasp/capture_clock.hpp), re-estimated once a second;
+/// says so when the capture clock's offset changes by more than a millisecond, or cannot be used.
+class CaptureClockFollower {
+ public:
+  CaptureClockFollower(sg::Bus& bus, sg::grasp::GraspNode& node) : bus_(bus), node_(node) {
+    char name[256] = {};
+    host_ = gethostname(name, sizeof name - 1) == 0 ? name : "?";
+    bus.subscribe<stereograsp::process_status_t>(
+        "PROCESS_STATUS",
+        [this](const auto& s, const auto& info) { watch_.receive(s, info.recv_utime); });
+  }
+  void poll(int64_t now) {
+    if (now < next_) return;
+    next_ = now + 1'000'000;
+    const auto e = sg::grasp::CaptureClock::estimate(watch_, *bus_.clock_sync(), host_);
+    if (!e.usable) {
+      if (!e.why.empty() && e.why != said_) spdlog::warn("{}", said_ = e.why);
+      return;
+    }
+    if (std::llabs(e.offset_us - node_.capture_clock_offset()) > 1000 || e.host != host_said_) {
+      spdlog::info(
+          "capture clock: {} on {}, {:+.1f} ms ± {:.1f} ms from this host's; forecast "
+          "times are put on this host's clock",
+          e.source, e.host, e.offset_us / 1e3, e.error_us / 1e3);
+      host_said_ = e.host;
+    }
+    node_.set_capture_clock_offset(e.offset_us);
+  }
+
+ private:
+  sg::Bus& bus_;
+  sg::grasp::GraspNode& node_;
+  sg::ProcessWatch watch_;
+  std::string host_, said_, host_said_;
+  int64_t next_ = 0;
+};
 
 int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
         const sg::grasp::GraspSettings& settings, double status_rate, sg::auth::LabAccess& lab) {
@@ -54,9 +95,11 @@ int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
                    to_string(r.reply.result), r.reply.reason);
     }
   });
+  CaptureClockFollower capture_clock(bus, node);
   spdlog::info("grasping {} prediction", settings.use_prediction ? "with" : "WITHOUT");
   while (!sg::shutdown_requested()) {
     bus.handle(std::chrono::milliseconds(10));
+    capture_clock.poll(sg::now_utime());
     const sg::grasp::GraspNode::Output out = node.poll(sg::now_utime());
     for (const auto& arm_command : {out.arm_command, out.lease}) {  // the request first
       if (!arm_command) continue;

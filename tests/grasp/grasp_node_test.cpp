@@ -485,5 +485,43 @@ TEST(GraspNodeTest, RejectionsDoNotStorm) {
       << status->message;
 }
 
+// A capture clock 1.5 s behind this host's makes every forecast look stale (older than
+// max_trajectory_age): a grasp is refused; with the offset known, the forecast is put on this
+// host's clock and the grasp is accepted. A clock 6 s ahead is refused outright (max_time_offset)
+// until the offset is known.
+TEST(GraspNodeTest, CaptureClockOffsetPutsTheForecastOnThisClock) {
+  Rig rig;
+  rig.connect();
+  auto shifted = [&](int64_t offset) {
+    trajectory_t m = rig.trajectory();
+    m.utime += offset, m.source_utime += offset, m.start_utime += offset;
+    return m;
+  };
+  EXPECT_EQ(rig.node.on_trajectory(shifted(-1'500'000), rig.now), "");
+  const CommandRecord& refused = rig.command(grasp_command_t::COMMAND_GRASP, 1);
+  EXPECT_EQ(refused.reply.result, CommandResult::kRefusedState);
+  EXPECT_EQ(refused.reply.reason, "grasp refused: no fresh track of the object");
+  rig.node.set_capture_clock_offset(-1'500'000);
+  EXPECT_EQ(rig.node.on_trajectory(shifted(-1'500'000), rig.now), "");
+  EXPECT_EQ(rig.command(grasp_command_t::COMMAND_GRASP, 2).reply.result, CommandResult::kAccepted);
+
+  Rig ahead;
+  EXPECT_NE(ahead.node
+                .on_trajectory(
+                    [&] {
+                      trajectory_t m = ahead.trajectory();
+                      m.utime += 6 * kSecond, m.source_utime += 6 * kSecond,
+                          m.start_utime += 6 * kSecond;
+                      return m;
+                    }(),
+                    ahead.now)
+                .find("s from the receiver's clock"),
+            std::string::npos);
+  ahead.node.set_capture_clock_offset(6 * kSecond);
+  trajectory_t m = ahead.trajectory();
+  m.utime += 6 * kSecond, m.source_utime += 6 * kSecond, m.start_utime += 6 * kSecond;
+  EXPECT_EQ(ahead.node.on_trajectory(m, ahead.now), "");
+}
+
 }  // namespace
 }  // namespace sg::grasp
