@@ -42,6 +42,8 @@ packages=(
   gnuplot-nox                                      # sg-report's PNG figures (pngcairo terminal)
   iproute2 util-linux                              # ip and unshare for scripts/multicast.sh
   iptables faketime                                # fault injection: packet loss, clock skew
+  openssh-client openssh-server                    # sg-lab: processes on other hosts; its tests'
+                                                   # hosts (network namespaces with an sshd)
 )
 # Only for scripts/fuzz.sh: clang with libFuzzer, ASan and UBSan runtimes (libclang-rt-dev),
 # and llvm-symbolizer (llvm) for file:line in sanitizer reports.

@@ -1,0 +1,91 @@
+#pragma once
+
+/// A lab's session: `sg-lab up`, `down`, `status`, `watch`, `logs` and `restart` (issue 18).
+///
+///     sg::lab::LabSession session(sg::lab::load_lab_file("config/lab.yaml"), project, out);
+///     session.up();        // every process on its host, in order, each ready before the next
+///     session.status(2.5); // a row per process, the hosts' clocks
+///     session.down();      // reverse order; the session log's path and its sg-report summary
+///
+/// `up` first checks the whole lab — every host answers over ssh, every binary and file is
+/// there, the lab is not already up — and refuses naming what is wrong, before it starts
+/// anything. It then copies the config and each process's files to the hosts that need them,
+/// starts the recorder (lcm-logger, logs/<lab>-<date>-<time>/session.lcmlog on its host) and
+/// each process under an `sg-lab supervise` on its host (supervisor.hpp), and waits for each
+/// to be ready: a stereograsp program's PROCESS_STATUS in state ready, from its host, or another
+/// program still running a second later. A process that does not get ready in time stops the
+/// `up`: what was started is stopped, and the process's log is shown.
+///
+/// The session's record lives in logs/<lab>-<date>-<time>/ of the local checkout
+/// (`sg-lab.state`: a line per process with its host, supervisor pid and log), and
+/// logs/<lab>.current points at it; each host keeps its processes' logs in the same folder of
+/// its own checkout.
+
+#include <memory>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "lab/lab_file.hpp"
+
+namespace sg::lab {
+
+/// One started process, as sg-lab.state records it.
+struct StartedProcess {
+  std::string name, host;
+  long pid = 0;     ///< the supervisor's, on its host
+  std::string log;  ///< relative to the project on its host
+};
+
+class LabSession {
+ public:
+  /// `project`: this checkout's absolute path; `out`: where progress and tables go.
+  LabSession(LabFile lab, std::string project, std::ostream& out);
+  ~LabSession();
+
+  /// Starts the lab; throws LabError (after stopping what it started) when it cannot.
+  void up();
+  /// Stops the lab's processes, the recorder last; prints the session log and its summary.
+  /// Returns 0, or 1 when a process had to be killed.
+  int down();
+  /// Listens `listen_s` to PROCESS_STATUS and prints a row per process and the clocks. Returns
+  /// 0 when every process is ready and every clock within tolerance, else 1.
+  int status(double listen_s);
+  /// Prints, until interrupted, processes joining, stopping beating, coming back or stopping,
+  /// supervisors that exited, and clock warnings.
+  int watch();
+  /// Prints the last `lines` of a process's log.
+  int logs(const std::string& name, int lines);
+  /// Restarts one process (its supervisor stops and starts it) and waits until it is ready.
+  void restart(const std::string& name);
+
+  /// Name of the session folder in use (after up(), or found by the other commands).
+  const std::string& session() const { return session_; }
+
+ private:
+  class Listener;  // the bus and the process watch, once needed
+  Listener& listener();
+  void preflight();
+  void copy_files();
+  void start(const ProcessSpec& p);
+  void wait_ready(const ProcessSpec& p, const StartedProcess& s, double since);
+  void stop(const StartedProcess& s, bool& killed);
+  void load_state();
+  void save_state() const;
+  bool alive(const StartedProcess& s);
+  std::string log_tail(const StartedProcess& s, int lines);
+  std::vector<std::string> argv_of(const ProcessSpec& p) const;
+  void report_session();
+
+  LabFile lab_;
+  std::string project_;
+  std::ostream& out_;
+  std::string session_;  ///< "<lab>-<date>-<time>"
+  std::vector<StartedProcess> started_;
+  std::unique_ptr<Listener> listener_;
+};
+
+/// The recorder as a process of the lab (lcm-logger), named "recorder".
+ProcessSpec recorder_process(const LabFile& lab, const std::string& session);
+
+}  // namespace sg::lab

@@ -1,0 +1,159 @@
+#!/usr/bin/env bash
+# Issue 18's lab, tried as a lab runs it: three machines (network namespaces with an sshd each,
+# scripts/lab_hosts.sh) — cameras and vision on lab1, predictor and grasp on lab2, the driver and
+# the C550 emulator on lab3 — started by `sg-lab up` from a fourth (this namespace), tracked and
+# grasped, watched, and stopped by `sg-lab down`. Root only; runs in a private network namespace
+# of its own (scripts/multicast.sh run), so nothing reaches the machine's network.
+#
+#   scripts/lab_trial.sh [--runs N] [--track S] [--loss PCT] [--loss-host HOST] [--skew S]
+#                        [--skew-host HOST] [--kill] [--out DIR] [--build-dir DIR]
+#
+#   --runs N        grasps, each a fresh `sg-lab up` ... `down` (default 1)
+#   --track S       s of tracking before the grasp command (default 40: the predictor learns)
+#   --loss PCT      drop PCT % of the UDP datagrams --loss-host (default lab2) receives
+#   --skew S        run --skew-host's (default lab1) processes S seconds off (libfaketime)
+#   --kill          in each run, kill -9 sg-vision on lab1 and time until `sg-lab watch` says so
+#
+# Per run: the time from `sg-lab up` to the first OBJECT_TRAJECTORY (from the session log), the
+# grasp's verdict (sg-grasp-ctl grasp --wait), the camera-to-trajectory latency p99 (sg-report),
+# arm motions executed twice (none may be), the clocks `sg-lab status` saw. Writes DIR/results.tsv
+# and DIR/summary.md; exit 0 when every run ran to a verdict.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+project=$(pwd)
+me=lab_trial
+
+if [ -z "${SG_LAB_TRIAL_INSIDE:-}" ]; then
+  [ "$(id -u)" -eq 0 ] || { echo "$me: needs root (network namespaces)" >&2; exit 2; }
+  exec scripts/multicast.sh run env SG_LAB_TRIAL_INSIDE=1 "$0" "$@"
+fi
+
+runs=1 track=40 loss=0 loss_host=lab2 skew=0 skew_host=lab1 kill_vision=0
+out="logs/$(date +%Y%m%d-%H%M%S)-lab-trial" build=build
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --runs) runs=$2; shift ;;
+    --track) track=$2; shift ;;
+    --loss) loss=$2; shift ;;
+    --loss-host) loss_host=$2; shift ;;
+    --skew) skew=$2; shift ;;
+    --skew-host) skew_host=$2; shift ;;
+    --kill) kill_vision=1 ;;
+    --out) out=$2; shift ;;
+    --build-dir) build=$2; shift ;;
+    -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
+    *) echo "$me: unknown option $1 (--help)" >&2; exit 2 ;;
+  esac
+  shift
+done
+build=$(cd "$build" && pwd)
+bin=$build/bin
+mkdir -p "$out"
+out=$(cd "$out" && pwd)
+hosts=$out/hosts
+url='udpm://239.255.76.67:7690?ttl=1'
+
+cleanup() {
+  [ -e "$out/lab.yaml" ] && "$bin/sg-lab" --lab "$out/lab.yaml" down >/dev/null 2>&1 || true
+  scripts/lab_hosts.sh down "$hosts" >/dev/null 2>&1 || true
+}
+trap cleanup EXIT
+
+scripts/lab_hosts.sh up "$hosts" 3
+"$bin/sg-keygen" "$out/lab.key" >/dev/null
+export SG_LAB_KEY=$out/lab.key
+"$bin/sg-camera-sim" --calibration-out "$out/calibration.yaml" --frames 1 --fast \
+  --lcm-url 'udpm://239.255.76.67:7691?ttl=0' >/dev/null
+
+# The lab file: the three hosts, the processes where the issue puts them.
+skew_env=""
+if [ "$skew" != 0 ]; then
+  faketime_lib=$(dpkg -L libfaketime | grep 'libfaketime.so.1$' | head -1)
+  skew_env=", LD_PRELOAD: $faketime_lib, FAKETIME: \"${skew}\", FAKETIME_DONT_FAKE_MONOTONIC: \"1\""
+fi
+host_line() {  # name: its address, folder, key and environment
+  local name=$1 env="SG_LAB_KEY: $out/lab.key"
+  [ "$name" = "$skew_host" ] && env="$env$skew_env"
+  echo "  - {name: $name, address: 10.231.0.$((10 + ${name#lab})), user: root, path: $hosts/$name, ssh_options: $(cat "$hosts/ssh_options.yaml"), env: {$env}}"
+}
+cat >"$out/lab.yaml" <<YAML
+lab: trial
+bus: $url
+config: config/stereograsp.yaml
+hosts:
+$(host_line lab1)
+$(host_line lab2)
+$(host_line lab3)
+processes:
+  - {name: c550, host: lab3, run: [sg-c550-sim, --link, $out/c550]}
+  - {name: driver, host: lab3, run: [sg-arm-driver, --device, $out/c550, --device-wait, "30"]}
+  - {name: cameras, host: lab1, run: [sg-camera-sim, --rate, "4"]}
+  - {name: vision, host: lab1, run: [sg-vision, --calibration, $out/calibration.yaml], files: [$out/calibration.yaml]}
+  - {name: predictor, host: lab2, run: [sg-predictor]}
+  - {name: grasp, host: lab2, run: [sg-grasp]}
+recorder: {host: lab2, exclude: CAMERA_.*}
+YAML
+"$bin/sg-lab" --lab "$out/lab.yaml" check
+[ "$loss" = 0 ] || scripts/lab_hosts.sh loss "$loss_host" "$loss"
+
+ctl() { "$bin/sg-grasp-ctl" "$@" --lcm-url "$url"; }
+now_ms() { date +%s%3N; }
+
+printf 'run\tup_s\tfirst_trajectory_s\theld\tverdict\tlatency_p99_ms\tmotions_twice\tkill_reported_s\tclock_warnings\n' \
+  >"$out/results.tsv"
+for run in $(seq 1 "$runs"); do
+  r=$out/run-$run
+  mkdir -p "$r"
+  t0=$(now_ms)
+  "$bin/sg-lab" --lab "$out/lab.yaml" up >"$r/up.txt" 2>&1 || { cat "$r/up.txt" >&2; exit 1; }
+  up_s=$(awk -v a="$t0" -v b="$(now_ms)" 'BEGIN { printf "%.1f", (b - a) / 1000 }')
+  session=$(readlink "$project/logs/trial.current")
+  "$bin/sg-lab" --lab "$out/lab.yaml" status >"$r/status.txt" 2>&1 || true
+  kill_s=-
+  if [ "$kill_vision" -eq 1 ]; then
+    "$bin/sg-lab" --lab "$out/lab.yaml" watch >"$r/watch.txt" 2>&1 &
+    watcher=$!
+    sleep 3
+    pid=$(awk '$1 == "vision" {print $4}' "$r/status.txt")
+    k0=$(now_ms)
+    kill -9 "$pid"
+    for _ in $(seq 1 100); do
+      grep -q "sg-vision@lab1:$pid stopped beating" "$r/watch.txt" && break
+      sleep 0.1
+    done
+    grep -q "sg-vision@lab1:$pid stopped beating" "$r/watch.txt" &&
+      kill_s=$(awk -v a="$k0" -v b="$(now_ms)" 'BEGIN { printf "%.1f", (b - a) / 1000 }')
+    kill -INT "$watcher"; wait "$watcher" || true
+  fi
+  ctl track >"$r/ctl.txt" 2>&1 || true
+  sleep "$track"
+  verdict=0
+  ctl grasp --wait --timeout 60 >>"$r/ctl.txt" 2>&1 || verdict=$?
+  "$bin/sg-lab" --lab "$out/lab.yaml" status >"$r/status-after.txt" 2>&1 || true
+  "$bin/sg-lab" --lab "$out/lab.yaml" down >"$r/down.txt" 2>&1 || true
+  log=$hosts/lab2/logs/$session/session.lcmlog
+  "$bin/sg-report" "$log" --out "$r/report" --no-plots --quiet >/dev/null 2>&1 || true
+  read -r first p99 twice warnings < <(python3 - "$r/report/report.json" "$t0" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+t0 = int(sys.argv[2]) * 1000
+first = next((c.get("first_recv_utime", 0) for c in j["channels"] if c["name"] == "OBJECT_TRAJECTORY"), 0)
+lat = j["latency_ms"].get("OBJECT_TRAJECTORY", {}).get("p99", float("nan"))
+twice = "-"  # TODO(issue 18): from sg-c550-sim --log-commands
+print(f'{(first - t0) / 1e6:.1f}' if first else "-", f"{lat:.2f}", twice, len(j["processes"]["clock_warnings"]))
+PY
+)
+  held=no; [ "$verdict" -eq 0 ] && held=yes
+  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$run" "$up_s" "$first" "$held" "$verdict" "$p99" \
+    "$twice" "$kill_s" "$warnings" >>"$out/results.tsv"
+  echo "$me: run $run: up in $up_s s, first trajectory at $first s, held $held, latency p99 $p99 ms, kill reported ${kill_s} s, clock warnings $warnings"
+done
+held=$(awk -F'\t' 'NR > 1 && $4 == "yes"' "$out/results.tsv" | wc -l)
+{
+  echo "# Lab trial: $runs run(s), loss $loss % on $loss_host, skew $skew s on $skew_host"
+  echo
+  echo "held $held of $runs"
+  echo
+  column -t -s $'\t' "$out/results.tsv"
+} >"$out/summary.md"
+cat "$out/summary.md"
