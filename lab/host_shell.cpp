@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -81,9 +82,9 @@ class LocalShell final : public HostShell {
     folder_ = host_.path.empty() ? project : host_.path;
   }
   CommandResult run(const std::string& command, double timeout_s) override {
-    CommandResult r =
-        run_argv({"sh", "-c", "cd " + shell_quote(folder_) + " && " + env_prefix(host_) + command},
-                 timeout_s);
+    CommandResult r = run_argv(
+        {"sh", "-c", "cd " + shell_quote(folder_) + " || exit 97; " + env_prefix(host_) + command},
+        timeout_s);
     r.command = command + " (on " + host_.name + ")";
     return r;
   }
@@ -103,6 +104,17 @@ class LocalShell final : public HostShell {
                    shell_quote(fs::absolute(local_path).string()) + " " + shell_quote(to.string()),
                timeout_s);
   }
+  CommandResult copy_all(const std::string& local_project, const std::vector<std::string>& files,
+                         double timeout_s) override {
+    namespace fs = std::filesystem;
+    CommandResult all;
+    all.exit_code = 0;
+    for (const std::string& f : files) {
+      all = copy((fs::path(local_project) / f).string(), f, timeout_s);
+      if (!all.ok()) return all;
+    }
+    return all;
+  }
   const HostSpec& host() const override { return host_; }
 
  private:
@@ -118,7 +130,7 @@ class SshShell final : public HostShell {
     std::vector<std::string> argv = ssh_base("ssh", "-p");
     argv.push_back(host_.destination());
     const std::string folder = host_.path.empty() ? "." : shell_quote(host_.path);
-    argv.push_back("cd " + folder + " && " + env_prefix(host_) + command);
+    argv.push_back("cd " + folder + " || exit 97; " + env_prefix(host_) + command);
     CommandResult r = run_argv(argv, timeout_s);
     r.command = command + " (on " + host_.name + " over ssh)";
     if (r.exit_code == 255)  // ssh's own failure: say so, not "exit 255"
@@ -150,19 +162,56 @@ class SshShell final : public HostShell {
     return run("mv -f " + shell_quote(fresh) + " " + shell_quote(target), timeout_s);
   }
 
+  CommandResult copy_all(const std::string& local_project, const std::vector<std::string>& files,
+                         double timeout_s) override {
+    // tar of the files as named (absolute ones kept absolute: -P), unpacked in the project's
+    // folder there. GNU tar unlinks a file before it writes it anew, so a host that shares
+    // this file system, or a process reading the old file, never sees it truncated.
+    std::string pack = "cd " + shell_quote(local_project) + " && tar -cPf -";
+    for (const std::string& f : files) pack.append(" ").append(shell_quote(f));
+    std::vector<std::string> ssh = ssh_base("ssh", "-p");
+    ssh.push_back(host_.destination());
+    const std::string folder = host_.path.empty() ? "." : shell_quote(host_.path);
+    ssh.push_back("cd " + folder + " && tar -xPf -");
+    std::string unpack;
+    for (const std::string& a : ssh) unpack.append(shell_quote(a)).append(" ");
+    CommandResult r =
+        run_argv({"bash", "-c", "set -o pipefail; " + pack + " | " + unpack}, timeout_s);
+    r.command = "copying " + std::to_string(files.size()) + " file(s) to " + host_.name;
+    return r;
+  }
   const HostSpec& host() const override { return host_; }
 
  private:
+  /// ssh's (or scp's) options: batch mode, a 5 s connection time-out, and one connection per
+  /// host shared by every call for 60 s (ControlMaster): sg-lab makes dozens of calls a session,
+  /// each of which would otherwise pay for a key exchange.
   std::vector<std::string> ssh_base(const std::string& program, const std::string& port_flag) {
     std::vector<std::string> argv = {program,
                                      "-o",
                                      "BatchMode=yes",
                                      "-o",
                                      "ConnectTimeout=5",
+                                     "-o",
+                                     "ControlMaster=auto",
+                                     "-o",
+                                     "ControlPath=" + control_folder() + "/%C",
+                                     "-o",
+                                     "ControlPersist=60",
                                      port_flag,
                                      std::to_string(host_.port)};
     argv.insert(argv.end(), host_.ssh_options.begin(), host_.ssh_options.end());
     return argv;
+  }
+  /// A folder of this user's only, for ssh's control sockets.
+  static std::string control_folder() {
+    const std::string folder = "/tmp/sg-lab-ssh-" + std::to_string(getuid());
+    mkdir(folder.c_str(), 0700);
+    struct stat st {};
+    if (lstat(folder.c_str(), &st) != 0 || !S_ISDIR(st.st_mode) || st.st_uid != getuid() ||
+        (st.st_mode & 077) != 0)
+      return "/nonexistent";  // someone else's: no shared connection (ssh then connects anew)
+    return folder;
   }
   HostSpec host_;
 };

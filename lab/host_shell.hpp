@@ -42,6 +42,11 @@ class HostShell {
   /// folder; a local host copies only when the two paths differ.
   virtual CommandResult copy(const std::string& local_path, const std::string& remote_path,
                              double timeout_s) = 0;
+  /// Copies files named relative to `local_project` (or absolute) to the same paths relative to
+  /// the project's folder on the host (or the same absolute paths), in one call: a tar stream
+  /// over one ssh connection; a local host copies only the files whose two paths differ.
+  virtual CommandResult copy_all(const std::string& local_project,
+                                 const std::vector<std::string>& files, double timeout_s) = 0;
   /// The host as the lab file defines it.
   virtual const HostSpec& host() const = 0;
 };

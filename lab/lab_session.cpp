@@ -52,16 +52,17 @@ std::string this_hostname() {
 
 }  // namespace
 
-/// The bus as sg-lab sees it: PROCESS_STATUS into a ProcessWatch, sg-lab itself announced (so it
-/// takes part in the clock exchange).
+/// The bus as sg-lab sees it: PROCESS_STATUS into a ProcessWatch; for `status` and `watch`,
+/// sg-lab announced itself, so that it takes part in the clock exchange (`up` only listens: its
+/// ssh calls would leave gaps in its heartbeats that a recorded session would list).
 class LabSession::Listener {
  public:
-  explicit Listener(const std::string& url) : bus(url) {
+  Listener(const std::string& url, bool take_part) : bus(url) {
     bus.subscribe<stereograsp::process_status_t>(
         "PROCESS_STATUS", [this](const stereograsp::process_status_t& s, const ReceiveInfo& info) {
           watch.receive(s, info.recv_utime);
         });
-    bus.announce("sg-lab");
+    if (take_part) bus.announce("sg-lab");
   }
   /// Handles messages for `seconds`.
   void listen(double seconds) {
@@ -93,8 +94,8 @@ LabSession::LabSession(LabFile lab, std::string project, std::ostream& out)
 
 LabSession::~LabSession() = default;
 
-LabSession::Listener& LabSession::listener() {
-  if (!listener_) listener_ = std::make_unique<Listener>(lab_.bus);
+LabSession::Listener& LabSession::listener(bool take_part) {
+  if (!listener_) listener_ = std::make_unique<Listener>(lab_.bus, take_part);
   return *listener_;
 }
 
@@ -153,6 +154,22 @@ bool LabSession::alive(const StartedProcess& s) {
   return make_shell(lab_.host(s.host), project_)->run(check, kShellTimeout).ok();
 }
 
+std::set<std::string> LabSession::running() {
+  std::map<std::string, std::string> checks;  // host -> one command for all its processes
+  for (const StartedProcess& s : started_)
+    checks[s.host] +=
+        "tr '\\0' ' ' < /proc/" + std::to_string(s.pid) + "/cmdline 2>/dev/null | grep -q -- " +
+        shell_quote("supervise --name " + s.name + " ") + " && echo " + shell_quote(s.name) + "; ";
+  std::set<std::string> names;
+  for (const auto& [host, command] : checks) {
+    const CommandResult r =
+        make_shell(lab_.host(host), project_)->run(command + "true", kShellTimeout);
+    std::istringstream lines(r.output);
+    for (std::string name; std::getline(lines, name);) names.insert(name);
+  }
+  return names;
+}
+
 std::string LabSession::log_tail(const StartedProcess& s, int lines) {
   const CommandResult r =
       make_shell(lab_.host(s.host), project_)
@@ -164,12 +181,14 @@ void LabSession::start(const ProcessSpec& p) {
   const auto t0 = Clock::now();
   const double stamp = static_cast<double>(now_utime());
   StartedProcess s{p.name, p.host, 0, "logs/" + session_ + "/" + p.name + ".log"};
-  std::string command = "mkdir -p logs/" + shell_quote(session_) + " && setsid " +
+  // Only the supervisor goes to the background, its output to the log: nothing of it holds the
+  // shell's (or ssh's) output open, so the command returns at once with its pid.
+  std::string command = "mkdir -p logs/" + shell_quote(session_) + " && { setsid " +
                         std::string(kBin) + "/sg-lab supervise --name " + shell_quote(p.name) +
                         " --restart " + to_string(p.restart) + " --stop-timeout " +
                         fixed(lab_.stop_timeout, 3) + " --";
   for (const std::string& a : argv_of(p)) command += " " + shell_quote(a);
-  command += " </dev/null >>" + shell_quote(s.log) + " 2>&1 & echo $!";
+  command += " </dev/null >>" + shell_quote(s.log) + " 2>&1 & echo $!; }";
   const CommandResult r = make_shell(lab_.host(p.host), project_)->run(command, kShellTimeout);
   s.pid = r.ok() ? std::strtol(r.output.c_str(), nullptr, 10) : 0;
   if (s.pid <= 0) throw LabError("process '" + p.name + "' on " + p.host + ": " + r.describe());
@@ -239,32 +258,37 @@ void LabSession::stop(const StartedProcess& s, bool& killed) {
 // ---- up --------------------------------------------------------------------------------------
 
 void LabSession::preflight() {
-  std::vector<std::string> problems;
-  for (const HostSpec& h : lab_.hosts) {
-    const CommandResult r =
-        make_shell(h, project_)->run("test -x " + std::string(kBin) + "/sg-lab", kShellTimeout);
-    if (r.exit_code == 255 || r.timed_out || r.exit_code < 0)
-      problems.push_back("host '" + h.name + "' (" + h.destination() + ":" +
-                         std::to_string(h.port) + ") is unreachable: " + r.describe());
-    else if (!r.ok())
-      problems.push_back("host '" + h.name + "': no " + kBin + "/sg-lab in " +
-                         (h.path.empty() ? project_ : h.path) + " (build the project there)");
+  // One call per host: it answers, and every program it is to run is there. Each missing thing
+  // is printed as "missing <what>".
+  std::map<std::string, std::string> checks;
+  for (const HostSpec& h : lab_.hosts)
+    checks[h.name] =
+        "test -x " + std::string(kBin) + "/sg-lab || echo 'missing " + kBin + "/sg-lab'; ";
+  for (const ProcessSpec& p : lab_.processes) {
+    const std::string program = argv_of(p)[0];
+    checks[p.host] += (p.stereograsp() ? "test -x " + shell_quote(program)
+                                       : "command -v " + shell_quote(program) + " >/dev/null") +
+                      " || echo " +
+                      shell_quote("missing " + program + " (process " + p.name + ")") + "; ";
   }
-  if (!problems.empty()) throw LabError(problems.front());
-  std::vector<ProcessSpec> all = lab_.processes;
-  for (const ProcessSpec& p : all) {
-    const std::vector<std::string> argv = argv_of(p);
-    const std::string test = p.stereograsp() ? "test -x " + shell_quote(argv[0])
-                                             : "command -v " + shell_quote(argv[0]) + " >/dev/null";
-    if (!make_shell(lab_.host(p.host), project_)->run(test, kShellTimeout).ok())
-      throw LabError(lab_.path + ":" + std::to_string(p.line) + ": process '" + p.name + "' on " +
-                     p.host + ": no program " + argv[0] +
-                     (p.stereograsp() ? " (build the project there)" : " on its PATH"));
+  for (const HostSpec& h : lab_.hosts) {
+    const CommandResult r = make_shell(h, project_)->run(checks[h.name] + "true", kShellTimeout);
+    if (!r.ok())
+      throw LabError("host '" + h.name + "' (" + h.destination() + ":" + std::to_string(h.port) +
+                     ") is unreachable: " + r.describe());
+    if (const size_t at = r.output.find("missing "); at != std::string::npos) {
+      const std::string what = r.output.substr(at + 8, r.output.find('\n', at) - at - 8);
+      throw LabError(lab_.path + ": host '" + h.name + "': no " + what + " in " +
+                     (h.path.empty() ? project_ : h.path) +
+                     (what.find("sg-") != std::string::npos ? " (build the project there)"
+                                                            : " (not on its PATH)"));
+    }
+  }
+  for (const ProcessSpec& p : lab_.processes)
     for (const std::string& f : p.files)
       if (!fs::exists(fs::path(project_) / f))
         throw LabError(lab_.path + ":" + std::to_string(p.line) + ": process '" + p.name +
                        "': no file " + f + " in " + project_);
-  }
   if (!lab_.config.empty() && !fs::exists(fs::path(project_) / lab_.config))
     throw LabError(lab_.path + ": config " + lab_.config + " is not in " + project_);
 }
@@ -277,12 +301,9 @@ void LabSession::copy_files() {
   }
   for (const auto& [host, files] : wanted) {
     auto shell = make_shell(lab_.host(host), project_);
-    for (const std::string& f : files) {
-      const CommandResult r = shell->copy((fs::path(project_) / f).string(), f, kShellTimeout);
-      if (!r.ok()) throw LabError("copying " + f + " to " + host + ": " + r.describe());
-    }
-    if (!files.empty())
-      out_ << "sg-lab: " << files.size() << " file(s) on " << host << " up to date\n";
+    const CommandResult r = shell->copy_all(project_, {files.begin(), files.end()}, kShellTimeout);
+    if (!r.ok()) throw LabError("copying files to " + host + ": " + r.describe());
+    out_ << "sg-lab: " << files.size() << " file(s) on " << host << " up to date\n";
   }
 }
 
@@ -307,8 +328,14 @@ void LabSession::up() {
     if (lab_.recorder.enabled) start(recorder_process(lab_, session_));
     for (const ProcessSpec& p : lab_.processes) start(p);
   } catch (const LabError&) {
-    out_ << "sg-lab: stopping what was started\n";
-    down();
+    if (!started_.empty()) {
+      out_ << "sg-lab: stopping what was started\n";
+      try {
+        down();
+      } catch (const LabError& e) {  // the first error is the one to report
+        out_ << "sg-lab: " << e.what() << "\n";
+      }
+    }
     throw;
   }
   save_state();
@@ -379,7 +406,7 @@ int LabSession::logs(const std::string& name, int lines) {
 
 int LabSession::status(double listen_s) {
   load_state();
-  Listener& l = listener();
+  Listener& l = listener(true);
   l.listen(listen_s);
   const int64_t now = now_utime();
   l.watch.check(now);
@@ -388,6 +415,7 @@ int LabSession::status(double listen_s) {
   std::snprintf(line, sizeof line, "%-12s %-10s %-16s %8s %-12s %8s %8s %8s %5s  %s\n", "NAME",
                 "HOST", "PROGRAM", "PID", "STATE", "UP", "IN/s", "OUT/s", "BAD", "LAST PROBLEM");
   out_ << "lab '" << lab_.lab << "', session " << session_ << "\n" << line;
+  const std::set<std::string> up = running();
   for (const StartedProcess& s : started_) {
     const ProcessSpec recorder = recorder_process(lab_, session_);
     const ProcessSpec* p = s.name == "recorder" ? &recorder : lab_.process(s.name);
@@ -398,15 +426,15 @@ int LabSession::status(double listen_s) {
       if (q.last.process == p->program() && q.last.host == host.hostname &&
           (!seen || q.last_heard > seen->last_heard))
         seen = &q;
-    const bool running = alive(s);
+    const bool running = up.count(s.name) > 0;
     std::string state = running ? "running" : "exited";
-    std::string up = "-", in = "-", out = "-", bad = "-", problem, pid = "-";
+    std::string uptime = "-", in = "-", out = "-", bad = "-", problem, pid = "-";
     if (seen && running) {
       const auto& st = seen->last;
       const double silence = (now - seen->last_heard) / 1e6;
       state = silence >= ProcessWatch::kSilentAfter ? "silent " + fixed(silence) + " s"
                                                     : state_name(st.state);
-      up = fixed((st.utime - st.start_utime) / 1e6 + silence, 0) + " s";
+      uptime = fixed((st.utime - st.start_utime) / 1e6 + silence, 0) + " s";
       double rin = 0, rout = 0;
       for (double r : st.rate_in_hz) rin += r;
       for (double r : st.rate_out_hz) rout += r;
@@ -424,7 +452,8 @@ int LabSession::status(double listen_s) {
     }
     std::snprintf(line, sizeof line, "%-12s %-10s %-16s %8s %-12s %8s %8s %8s %5s  %s\n",
                   s.name.c_str(), s.host.c_str(), p->program().c_str(), pid.c_str(), state.c_str(),
-                  up.c_str(), in.c_str(), out.c_str(), bad.c_str(), problem.substr(0, 160).c_str());
+                  uptime.c_str(), in.c_str(), out.c_str(), bad.c_str(),
+                  problem.substr(0, 160).c_str());
     out_ << line;
   }
   const std::string self = this_hostname();
@@ -440,7 +469,7 @@ int LabSession::status(double listen_s) {
 
 int LabSession::watch() {
   load_state();
-  Listener& l = listener();
+  Listener& l = listener(true);
   const std::string self = this_hostname();
   std::set<std::string> warned, gone;
   auto next_check = Clock::now();
@@ -455,8 +484,9 @@ int LabSession::watch() {
       if (warned.insert(w.substr(0, w.find(" is "))).second) out_ << "warning: " << w << "\n";
     if (Clock::now() >= next_check) {
       next_check = Clock::now() + std::chrono::seconds(2);
+      const std::set<std::string> up = running();
       for (const StartedProcess& s : started_)
-        if (!gone.count(s.name) && !alive(s)) {
+        if (!gone.count(s.name) && !up.count(s.name)) {
           gone.insert(s.name);
           out_ << s.name << " on " << s.host << ": its supervisor exited (sg-lab logs " << s.name
                << ")\n";

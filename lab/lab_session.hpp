@@ -23,6 +23,7 @@
 
 #include <memory>
 #include <ostream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -64,7 +65,7 @@ class LabSession {
 
  private:
   class Listener;  // the bus and the process watch, once needed
-  Listener& listener();
+  Listener& listener(bool take_part = false);
   void preflight();
   void copy_files();
   void start(const ProcessSpec& p);
@@ -73,6 +74,8 @@ class LabSession {
   void load_state();
   void save_state() const;
   bool alive(const StartedProcess& s);
+  /// The names of the started processes whose supervisors run (one ssh call per host).
+  std::set<std::string> running();
   std::string log_tail(const StartedProcess& s, int lines);
   std::vector<std::string> argv_of(const ProcessSpec& p) const;
   void report_session();

@@ -58,6 +58,10 @@ UsePAM no
 StrictModes no
 PidFile $dir/$name.sshd/pid
 AcceptEnv LANG
+Subsystem sftp /usr/lib/openssh/sftp-server
+# bash reads ~/.bashrc for an ssh command unless it is a nested shell: this machine's costs
+# 0.5 s (pyenv) a call, which is not what sg-lab's figures are about
+SetEnv SHLVL=1
 CONF
   mkdir -p /run/sshd
   ip netns exec "$ns" unshare --uts sh -c "hostname $name && exec /usr/sbin/sshd -f $dir/$name.sshd/sshd_config -E $dir/$name.sshd/log"
