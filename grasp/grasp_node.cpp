@@ -84,6 +84,16 @@ void GraspNode::require_signed_commands(const auth::LabKey& key, std::string cha
 }
 
 const CommandRecord& GraspNode::on_command(const stereograsp::grasp_command_t& m, int64_t now) {
+  // A resend of the command last answered, by the sender it was verified from (sg-grasp-ctl
+  // resends until it hears the answer: the bus may lose the command or the answer): the same
+  // answer again, on the next GRASP_STATUS; nothing is verified or carried out twice.
+  if (resend_of_last_ && m.sequence == command_.sequence && m.sender == resend_of_last_->sender &&
+      m.command == resend_of_last_->command && m.standoff == resend_of_last_->standoff &&
+      m.auth_counter == resend_of_last_->auth_counter) {
+    command_changed_ = true;
+    return command_;
+  }
+  resend_of_last_.reset();
   if (verifier_) {
     const auth::Verification v = verifier_->verify(command_channel_, m, now);
     if (!v.accepted()) {
@@ -91,6 +101,7 @@ const CommandRecord& GraspNode::on_command(const stereograsp::grasp_command_t& m
                     "unauthenticated: " + v.reason);
     }
   }
+  resend_of_last_ = m;
   std::string why;
   if (!newer(m, now, &why)) return answer(m.sequence, CommandResult::kRefusedNotNewer, why);
   if (m.command < stereograsp::grasp_command_t::COMMAND_TRACK ||

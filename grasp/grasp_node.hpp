@@ -171,6 +171,9 @@ class GraspNode {
   std::optional<auth::CommandVerifier> verifier_;  ///< set by require_signed_commands()
   std::string command_channel_;
   CommandRecord command_;
+  /// The command command_ answers, once verified (not after a refused signature): an identical
+  /// message again is a resend.
+  std::optional<stereograsp::grasp_command_t> resend_of_last_;
   bool command_changed_ = false;
   std::string last_summary_;
   std::array<uint64_t, kTrajectoryRefusals> refused_{};

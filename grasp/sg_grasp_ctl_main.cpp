@@ -42,8 +42,9 @@ void print(const Status& s) {
 
 /// Handles the bus until `done(status)` holds for a status received or the time-out; returns the
 /// last status seen.
-std::optional<Status> watch(sg::Bus& bus, double timeout, bool follow,
-                            const std::function<bool(const Status&)>& done) {
+std::optional<Status> watch(
+    sg::Bus& bus, double timeout, bool follow, const std::function<bool(const Status&)>& done,
+    const std::function<void()>& meanwhile = [] {}) {
   std::optional<Status> last;
   bool finished = false;
   bus.subscribe<Status>("GRASP_STATUS", [&](const Status& s, const sg::ReceiveInfo&) {
@@ -58,6 +59,7 @@ std::optional<Status> watch(sg::Bus& bus, double timeout, bool follow,
   const auto give_up = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout);
   while (!sg::shutdown_requested() && std::chrono::steady_clock::now() < give_up && !finished) {
     bus.handle(std::chrono::milliseconds(50));
+    meanwhile();
   }
   return last;
 }
@@ -89,7 +91,16 @@ int send(sg::Bus& bus, sg::auth::LabAccess& lab, int8_t command, double standoff
       return s.activity != Status::ACTIVITY_GRASPING && s.outcome != Status::OUTCOME_NONE;
     return s.activity == Status::ACTIVITY_IDLE;
   };
-  const auto last = watch(bus, timeout, wait, finished);
+  // The bus may lose the command or its answer: the very same message again every 0.5 s until
+  // the answer comes (sg-grasp answers a resend with the first answer and does nothing twice).
+  auto resend_at = std::chrono::steady_clock::now() + std::chrono::milliseconds(500);
+  const auto last = watch(
+      bus, timeout, wait, [&](const Status& s) { return finished(s); },
+      [&] {
+        if (result || std::chrono::steady_clock::now() < resend_at) return;
+        bus.publish("GRASP_COMMAND", c);
+        resend_at = std::chrono::steady_clock::now() + std::chrono::milliseconds(500);
+      });
   if (!last) throw std::runtime_error("no GRASP_STATUS: is sg-grasp running on this bus?");
   if (!result) throw std::runtime_error("sg-grasp did not answer the command within the time-out");
   if (*result != Status::RESULT_ACCEPTED) {

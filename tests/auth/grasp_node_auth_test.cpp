@@ -78,7 +78,8 @@ TEST(GraspNodeAuth, UnsignedCommandIsRefusedAndReported) {
 }
 
 // A forged HOME with sequence 2^63-1 is refused and leaves the operator's sequence alone: the
-// signed HOME with sequence 5 that follows is accepted; its bytes again are a replay.
+// signed HOME with sequence 5 that follows is accepted; its bytes again at once are a resend,
+// answered again; after another command, a replay.
 TEST(GraspNodeAuth, ForgedSequenceLocksNoOneOut) {
   SignedRig rig;
   grasp_command_t forged = home(std::numeric_limits<int64_t>::max());
@@ -96,15 +97,21 @@ TEST(GraspNodeAuth, ForgedSequenceLocksNoOneOut) {
   EXPECT_EQ(r.reply.result, CommandResult::kAccepted) << r.reply.reason;
   EXPECT_EQ(rig.node.machine().status().activity, GraspActivity::kHoming);
 
+  // Its bytes again at once are a resend (sg-grasp-ctl's, when the answer was lost): the same
+  // answer, neither verified nor carried out again.
   const CommandRecord& again = rig.node.on_command(real, kT0);
-  EXPECT_EQ(again.reply.result, CommandResult::kRefusedUnauthenticated);
-  EXPECT_EQ(again.reply.reason.rfind("unauthenticated: replayed: auth_counter", 0), 0u)
-      << again.reply.reason;
+  EXPECT_EQ(again.reply.result, CommandResult::kAccepted);
+  EXPECT_EQ(rig.node.command_verifier()->count(auth::Verdict::kAccepted), 1);
   // Signed for another channel, or with another key: refused too.
   grasp_command_t elsewhere = home(6);
   operator_signer.sign("ARM_COMMAND", elsewhere);
   EXPECT_EQ(rig.node.on_command(elsewhere, kT0).reply.result,
             CommandResult::kRefusedUnauthenticated);
+  // After another command, the old bytes are a replay.
+  const CommandRecord& replay = rig.node.on_command(real, kT0);
+  EXPECT_EQ(replay.reply.result, CommandResult::kRefusedUnauthenticated);
+  EXPECT_EQ(replay.reply.reason.rfind("unauthenticated: replayed: auth_counter", 0), 0u)
+      << replay.reply.reason;
   EXPECT_EQ(rig.node.command_verifier()->count(auth::Verdict::kAccepted), 1);
   EXPECT_EQ(rig.node.command_verifier()->count(auth::Verdict::kBadTag), 2);
   EXPECT_EQ(rig.node.command_verifier()->count(auth::Verdict::kReplayed), 1);

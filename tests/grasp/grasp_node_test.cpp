@@ -101,6 +101,25 @@ struct Rig {
 
 // A command whose sequence is not newer than its sender's last is refused, and the machine does
 // not see it; each sender has its own sequence.
+// A resend of the command last answered (the bus lost the answer, or the command) gets the same
+// answer again, and is not carried out twice; the same sequence with another command is refused.
+TEST(GraspNodeTest, ResendOfTheLastCommandGetsItsAnswerAgain) {
+  Rig rig;
+  rig.connect();
+  rig.feed();
+  EXPECT_EQ(rig.command(grasp_command_t::COMMAND_TRACK, 5).reply.result, CommandResult::kAccepted);
+  rig.run(0.5);
+  const CommandRecord& again = rig.command(grasp_command_t::COMMAND_TRACK, 5);
+  EXPECT_EQ(again.sequence, 5);
+  EXPECT_EQ(again.reply.result, CommandResult::kAccepted);
+  const GraspNode::Output out = rig.poll();
+  ASSERT_TRUE(out.status) << "the answer is published again at once";
+  EXPECT_EQ(out.status->command_sequence, 5);
+  EXPECT_EQ(out.status->command_result, grasp_status_t::RESULT_ACCEPTED);
+  EXPECT_EQ(rig.command(grasp_command_t::COMMAND_HOME, 5).reply.result,
+            CommandResult::kRefusedNotNewer);
+}
+
 TEST(GraspNodeTest, RefusesCommandsNotNewerThanTheSendersLast) {
   Rig rig;
   rig.connect();
@@ -160,10 +179,11 @@ TEST(GraspNodeTest, StatusCarriesTheCommandsResult) {
   EXPECT_EQ(refused.status->command_result, grasp_status_t::RESULT_REFUSED_STATE);
   EXPECT_EQ(refused.status->command_reason, "grasp refused: no fresh track of the object");
   rig.advance(0.01);
-  rig.command(grasp_command_t::COMMAND_GRASP, 7);  // the same refusal text, a replay
+  rig.command(grasp_command_t::COMMAND_GRASP, 7);  // a resend: its answer again, not "not newer"
   GraspNode::Output replay = rig.poll();
   ASSERT_TRUE(replay.status.has_value());
-  EXPECT_EQ(replay.status->command_result, grasp_status_t::RESULT_REFUSED_NOT_NEWER);
+  EXPECT_EQ(replay.status->command_sequence, 7);
+  EXPECT_EQ(replay.status->command_result, grasp_status_t::RESULT_REFUSED_STATE);
   rig.advance(0.01);
   rig.feed();
   rig.command(grasp_command_t::COMMAND_GRASP, 8);
