@@ -184,22 +184,24 @@ class SshShell final : public HostShell {
 
  private:
   /// ssh's (or scp's) options: batch mode, a 5 s connection time-out, and one connection per
-  /// host shared by every call for 60 s (ControlMaster): sg-lab makes dozens of calls a session,
-  /// each of which would otherwise pay for a key exchange.
+  /// host shared by this sg-lab's calls (ControlMaster; each sg-lab its own, kept 15 s after the
+  /// last call, so a host that went away meanwhile is never reached through a dead connection):
+  /// `up` makes a dozen calls or more, each of which would otherwise pay for a key exchange.
   std::vector<std::string> ssh_base(const std::string& program, const std::string& port_flag) {
-    std::vector<std::string> argv = {program,
-                                     "-o",
-                                     "BatchMode=yes",
-                                     "-o",
-                                     "ConnectTimeout=5",
-                                     "-o",
-                                     "ControlMaster=auto",
-                                     "-o",
-                                     "ControlPath=" + control_folder() + "/%C",
-                                     "-o",
-                                     "ControlPersist=60",
-                                     port_flag,
-                                     std::to_string(host_.port)};
+    std::vector<std::string> argv = {
+        program,
+        "-o",
+        "BatchMode=yes",
+        "-o",
+        "ConnectTimeout=5",
+        "-o",
+        "ControlMaster=auto",
+        "-o",
+        "ControlPath=" + control_folder() + "/%C-" + std::to_string(getpid()),
+        "-o",
+        "ControlPersist=15",
+        port_flag,
+        std::to_string(host_.port)};
     argv.insert(argv.end(), host_.ssh_options.begin(), host_.ssh_options.end());
     return argv;
   }

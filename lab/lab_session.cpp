@@ -89,8 +89,11 @@ ProcessSpec recorder_process(const LabFile& lab, const std::string& session) {
   return p;
 }
 
-LabSession::LabSession(LabFile lab, std::string project, std::ostream& out)
-    : lab_(std::move(lab)), project_(std::move(project)), out_(out) {}
+LabSession::LabSession(LabFile lab, std::string project, std::ostream& out, std::string state)
+    : lab_(std::move(lab)),
+      project_(std::move(project)),
+      state_(state.empty() ? project_ + "/logs" : std::move(state)),
+      out_(out) {}
 
 LabSession::~LabSession() = default;
 
@@ -111,24 +114,25 @@ std::vector<std::string> LabSession::argv_of(const ProcessSpec& p) const {
 // ---- the state file -------------------------------------------------------------------------
 
 void LabSession::save_state() const {
-  const fs::path folder = fs::path(project_) / "logs" / session_;
+  const fs::path folder = fs::path(state_) / session_;
   fs::create_directories(folder);
   std::ofstream f(folder / "sg-lab.state");
   for (const StartedProcess& s : started_)
     f << s.name << '\t' << s.host << '\t' << s.pid << '\t' << s.log << '\n';
-  const fs::path current = fs::path(project_) / "logs" / (lab_.lab + ".current");
+  const fs::path current = fs::path(state_) / (lab_.lab + ".current");
   std::error_code ec;
   fs::remove(current, ec);
   fs::create_symlink(session_, current, ec);
 }
 
 void LabSession::load_state() {
-  const fs::path current = fs::path(project_) / "logs" / (lab_.lab + ".current");
+  const fs::path current = fs::path(state_) / (lab_.lab + ".current");
   std::error_code ec;
   const fs::path target = fs::read_symlink(current, ec);
   if (ec) throw LabError("lab '" + lab_.lab + "' is not up (no " + current.string() + ")");
+  // (the state folder: --state, else logs/ of this checkout)
   session_ = target.filename().string();
-  std::ifstream f(fs::path(project_) / "logs" / session_ / "sg-lab.state");
+  std::ifstream f(fs::path(state_) / session_ / "sg-lab.state");
   if (!f) throw LabError("lab '" + lab_.lab + "': session " + session_ + " has no sg-lab.state");
   started_.clear();
   std::string line;
@@ -356,7 +360,7 @@ int LabSession::down() {
   for (auto s = started_.rbegin(); s != started_.rend(); ++s) stop(*s, killed);
   report_session();
   std::error_code ec;
-  fs::remove(fs::path(project_) / "logs" / (lab_.lab + ".current"), ec);
+  fs::remove(fs::path(state_) / (lab_.lab + ".current"), ec);
   return killed ? 1 : 0;
 }
 

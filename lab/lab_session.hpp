@@ -16,9 +16,9 @@
 /// program still running a second later. A process that does not get ready in time stops the
 /// `up`: what was started is stopped, and the process's log is shown.
 ///
-/// The session's record lives in logs/<lab>-<date>-<time>/ of the local checkout
-/// (`sg-lab.state`: a line per process with its host, supervisor pid and log), and
-/// logs/<lab>.current points at it; each host keeps its processes' logs in the same folder of
+/// The session's record lives in logs/<lab>-<date>-<time>/ of the local checkout, or of
+/// `--state DIR` (`sg-lab.state`: a line per process with its host, supervisor pid and log), and
+/// <lab>.current there points at it; each host keeps its processes' logs in the same folder of
 /// its own checkout.
 
 #include <memory>
@@ -40,8 +40,9 @@ struct StartedProcess {
 
 class LabSession {
  public:
-  /// `project`: this checkout's absolute path; `out`: where progress and tables go.
-  LabSession(LabFile lab, std::string project, std::ostream& out);
+  /// `project`: this checkout's absolute path; `out`: where progress and tables go; `state`: the
+  /// folder of the session's record ("" for `project`/logs).
+  LabSession(LabFile lab, std::string project, std::ostream& out, std::string state = "");
   ~LabSession();
 
   /// Starts the lab; throws LabError (after stopping what it started) when it cannot.
@@ -82,6 +83,7 @@ class LabSession {
 
   LabFile lab_;
   std::string project_;
+  std::string state_;  ///< where sg-lab.state and <lab>.current live
   std::ostream& out_;
   std::string session_;  ///< "<lab>-<date>-<time>"
   std::vector<StartedProcess> started_;

@@ -41,6 +41,7 @@ std::string project_folder() {
 
 struct Options {
   std::string lab_file;
+  std::string state;
   double listen_s = 2.5;
   int lines = 40;
   std::string name;
@@ -81,6 +82,9 @@ int main(int argc, char** argv) {
   const std::string project = project_folder();
   o.lab_file = (fs::path(project) / "config/lab.yaml").string();
   app.add_option("--lab", o.lab_file, "the lab file")->capture_default_str();
+  app.add_option("--state", o.state,
+                 "folder of the sessions' records (sg-lab.state, <lab>.current); default: logs/ "
+                 "of this checkout");
   CLI::App* up = app.add_subcommand("up", "Start every process on its host, in order");
   CLI::App* down = app.add_subcommand("down", "Stop every process, the recorder last; report");
   CLI::App* status = app.add_subcommand("status", "Each process's host, state, rates; the clocks");
@@ -105,7 +109,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     sg::install_shutdown_handlers();
-    sg::lab::LabSession session(lab, project, std::cout);
+    sg::lab::LabSession session(lab, project, std::cout, o.state);
     try {
       if (*up) session.up();
       if (*down) return session.down();

@@ -6,18 +6,19 @@
 # of its own (scripts/multicast.sh run), so nothing reaches the machine's network.
 #
 #   scripts/lab_trial.sh [--runs N] [--track S] [--loss PCT] [--loss-host HOST] [--skew S]
-#                        [--skew-host HOST] [--kill] [--out DIR] [--build-dir DIR]
+#                        [--skew-host HOST] [--kill] [--one-host] [--out DIR] [--build-dir DIR]
 #
 #   --runs N        grasps, each a fresh `sg-lab up` ... `down` (default 1)
 #   --track S       s of tracking before the grasp command (default 40: the predictor learns)
 #   --loss PCT      drop PCT % of the UDP datagrams --loss-host (default lab2) receives
 #   --skew S        run --skew-host's (default lab1) processes S seconds off (libfaketime)
 #   --kill          in each run, kill -9 sg-vision on lab1 and time until `sg-lab watch` says so
+#   --one-host      every process on lab1 (the baseline for the latency across hosts)
 #
 # Per run: the time from `sg-lab up` to the first OBJECT_TRAJECTORY (from the session log), the
-# grasp's verdict (sg-grasp-ctl grasp --wait), the camera-to-trajectory latency p99 (sg-report),
-# arm motions executed twice (none may be), the clocks `sg-lab status` saw. Writes DIR/results.tsv
-# and DIR/summary.md; exit 0 when every run ran to a verdict.
+# grasp's verdict (sg-grasp-ctl grasp --wait), the camera-to-trajectory latency p50 and p99
+# (sg-report), the clock warnings in the session's report. Writes DIR/results.tsv and
+# DIR/summary.md; exit 0 when every run ran to a verdict.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 project=$(pwd)
@@ -28,7 +29,7 @@ if [ -z "${SG_LAB_TRIAL_INSIDE:-}" ]; then
   exec scripts/multicast.sh run env SG_LAB_TRIAL_INSIDE=1 "$0" "$@"
 fi
 
-runs=1 track=40 loss=0 loss_host=lab2 skew=0 skew_host=lab1 kill_vision=0
+runs=1 track=40 loss=0 loss_host=lab2 skew=0 skew_host=lab1 kill_vision=0 one_host=0
 out="logs/$(date +%Y%m%d-%H%M%S)-lab-trial" build=build
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -39,6 +40,7 @@ while [ $# -gt 0 ]; do
     --skew) skew=$2; shift ;;
     --skew-host) skew_host=$2; shift ;;
     --kill) kill_vision=1 ;;
+    --one-host) one_host=1 ;;
     --out) out=$2; shift ;;
     --build-dir) build=$2; shift ;;
     -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
@@ -54,7 +56,7 @@ hosts=$out/hosts
 url='udpm://239.255.76.67:7690?ttl=1'
 
 cleanup() {
-  [ -e "$out/lab.yaml" ] && "$bin/sg-lab" --lab "$out/lab.yaml" down >/dev/null 2>&1 || true
+  [ -e "$out/lab.yaml" ] && "$bin/sg-lab" --state "$out/state" --lab "$out/lab.yaml" down >/dev/null 2>&1 || true
   scripts/lab_hosts.sh down "$hosts" >/dev/null 2>&1 || true
 }
 trap cleanup EXIT
@@ -76,6 +78,7 @@ host_line() {  # name: its address, folder, key and environment
   [ "$name" = "$skew_host" ] && env="$env$skew_env"
   echo "  - {name: $name, address: 10.231.0.$((10 + ${name#lab})), user: root, path: $hosts/$name, ssh_options: $(cat "$hosts/ssh_options.yaml"), env: {$env}}"
 }
+on() { [ "$one_host" -eq 1 ] && echo lab1 || echo "$1"; }  # where a process runs
 cat >"$out/lab.yaml" <<YAML
 lab: trial
 bus: $url
@@ -85,33 +88,33 @@ $(host_line lab1)
 $(host_line lab2)
 $(host_line lab3)
 processes:
-  - {name: c550, host: lab3, run: [sg-c550-sim, --link, $out/c550]}
-  - {name: driver, host: lab3, run: [sg-arm-driver, --device, $out/c550, --device-wait, "30"]}
+  - {name: c550, host: $(on lab3), run: [sg-c550-sim, --link, $out/c550]}
+  - {name: driver, host: $(on lab3), run: [sg-arm-driver, --device, $out/c550, --device-wait, "30"]}
   - {name: cameras, host: lab1, run: [sg-camera-sim, --rate, "4"]}
   - {name: vision, host: lab1, run: [sg-vision, --calibration, $out/calibration.yaml], files: [$out/calibration.yaml]}
-  - {name: predictor, host: lab2, run: [sg-predictor]}
-  - {name: grasp, host: lab2, run: [sg-grasp]}
-recorder: {host: lab2, exclude: CAMERA_.*}
+  - {name: predictor, host: $(on lab2), run: [sg-predictor]}
+  - {name: grasp, host: $(on lab2), run: [sg-grasp]}
+recorder: {host: $(on lab2), exclude: CAMERA_.*}
 YAML
-"$bin/sg-lab" --lab "$out/lab.yaml" check
+"$bin/sg-lab" --state "$out/state" --lab "$out/lab.yaml" check
 [ "$loss" = 0 ] || scripts/lab_hosts.sh loss "$loss_host" "$loss"
 
 ctl() { "$bin/sg-grasp-ctl" "$@" --lcm-url "$url"; }
 now_ms() { date +%s%3N; }
 
-printf 'run\tup_s\tfirst_trajectory_s\theld\tverdict\tlatency_p99_ms\tmotions_twice\tkill_reported_s\tclock_warnings\n' \
+printf 'run\tup_s\tfirst_trajectory_s\theld\tverdict\tlatency_p50_ms\tlatency_p99_ms\tkill_reported_s\tclock_warnings\n' \
   >"$out/results.tsv"
 for run in $(seq 1 "$runs"); do
   r=$out/run-$run
   mkdir -p "$r"
   t0=$(now_ms)
-  "$bin/sg-lab" --lab "$out/lab.yaml" up >"$r/up.txt" 2>&1 || { cat "$r/up.txt" >&2; exit 1; }
+  "$bin/sg-lab" --state "$out/state" --lab "$out/lab.yaml" up >"$r/up.txt" 2>&1 || { cat "$r/up.txt" >&2; exit 1; }
   up_s=$(awk -v a="$t0" -v b="$(now_ms)" 'BEGIN { printf "%.1f", (b - a) / 1000 }')
-  session=$(readlink "$project/logs/trial.current")
-  "$bin/sg-lab" --lab "$out/lab.yaml" status >"$r/status.txt" 2>&1 || true
+  session=$(readlink "$out/state/trial.current")
+  "$bin/sg-lab" --state "$out/state" --lab "$out/lab.yaml" status >"$r/status.txt" 2>&1 || true
   kill_s=-
   if [ "$kill_vision" -eq 1 ]; then
-    "$bin/sg-lab" --lab "$out/lab.yaml" watch >"$r/watch.txt" 2>&1 &
+    "$bin/sg-lab" --state "$out/state" --lab "$out/lab.yaml" watch >"$r/watch.txt" 2>&1 &
     watcher=$!
     sleep 3
     pid=$(awk '$1 == "vision" {print $4}' "$r/status.txt")
@@ -129,28 +132,28 @@ for run in $(seq 1 "$runs"); do
   sleep "$track"
   verdict=0
   ctl grasp --wait --timeout 60 >>"$r/ctl.txt" 2>&1 || verdict=$?
-  "$bin/sg-lab" --lab "$out/lab.yaml" status >"$r/status-after.txt" 2>&1 || true
-  "$bin/sg-lab" --lab "$out/lab.yaml" down >"$r/down.txt" 2>&1 || true
-  log=$hosts/lab2/logs/$session/session.lcmlog
+  "$bin/sg-lab" --state "$out/state" --lab "$out/lab.yaml" status >"$r/status-after.txt" 2>&1 || true
+  "$bin/sg-lab" --state "$out/state" --lab "$out/lab.yaml" down >"$r/down.txt" 2>&1 || true
+  log=$hosts/$(on lab2)/logs/$session/session.lcmlog
   "$bin/sg-report" "$log" --out "$r/report" --no-plots --quiet >/dev/null 2>&1 || true
-  read -r first p99 twice warnings < <(python3 - "$r/report/report.json" "$t0" <<'PY'
+  read -r first p50 p99 warnings < <(python3 - "$r/report/report.json" "$t0" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1]))
 t0 = int(sys.argv[2]) * 1000
 first = next((c.get("first_recv_utime", 0) for c in j["channels"] if c["name"] == "OBJECT_TRAJECTORY"), 0)
-lat = j["latency_ms"].get("OBJECT_TRAJECTORY", {}).get("p99", float("nan"))
-twice = "-"  # TODO(issue 18): from sg-c550-sim --log-commands
-print(f'{(first - t0) / 1e6:.1f}' if first else "-", f"{lat:.2f}", twice, len(j["processes"]["clock_warnings"]))
+lat = j["latency_ms"].get("OBJECT_TRAJECTORY", {})
+print(f'{(first - t0) / 1e6:.1f}' if first else "-", f'{lat.get("p50", float("nan")):.2f}',
+      f'{lat.get("p99", float("nan")):.2f}', len(j["processes"]["clock_warnings"]))
 PY
 )
   held=no; [ "$verdict" -eq 0 ] && held=yes
-  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$run" "$up_s" "$first" "$held" "$verdict" "$p99" \
-    "$twice" "$kill_s" "$warnings" >>"$out/results.tsv"
-  echo "$me: run $run: up in $up_s s, first trajectory at $first s, held $held, latency p99 $p99 ms, kill reported ${kill_s} s, clock warnings $warnings"
+  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$run" "$up_s" "$first" "$held" "$verdict" "$p50" \
+    "$p99" "$kill_s" "$warnings" >>"$out/results.tsv"
+  echo "$me: run $run: up in $up_s s, first trajectory at $first s, held $held, latency p50 $p50 p99 $p99 ms, kill reported ${kill_s} s, clock warnings $warnings"
 done
 held=$(awk -F'\t' 'NR > 1 && $4 == "yes"' "$out/results.tsv" | wc -l)
 {
-  echo "# Lab trial: $runs run(s), loss $loss % on $loss_host, skew $skew s on $skew_host"
+  echo "# Lab trial: $runs run(s), loss $loss % on $loss_host, skew $skew s on $skew_host$([ "$one_host" -eq 1 ] && echo ', every process on lab1')"
   echo
   echo "held $held of $runs"
   echo
