@@ -217,6 +217,9 @@ void read_recorder(Reader& top, LabFile& lab, const std::string& file) {
 
 }  // namespace
 
+/// parse_lab_file's body; yaml-cpp's own exceptions pass through it.
+LabFile parse_yaml(const std::string& text, const std::string& name);
+
 bool HostSpec::local() const {
   return address.empty() || address == "localhost" || address == "127.0.0.1" || address == "::1";
 }
@@ -244,13 +247,19 @@ const ProcessSpec* LabFile::process(const std::string& name) const {
 }
 
 LabFile parse_lab_file(const std::string& text, const std::string& name) {
-  YAML::Node root;
   try {
-    root = YAML::Load(text);
-  } catch (const YAML::ParserException& e) {
-    throw LabError(name + ":" + std::to_string(e.mark.line + 1) + ":" +
-                   std::to_string(e.mark.column + 1) + ": not YAML: " + e.msg);
+    return parse_yaml(text, name);
+  } catch (const YAML::Exception& e) {  // not YAML, or a value of a kind no key takes
+    std::ostringstream where;
+    where << name;
+    if (e.mark.line >= 0) where << ':' << e.mark.line + 1 << ':' << e.mark.column + 1;
+    where << ": " << (dynamic_cast<const YAML::ParserException*>(&e) ? "not YAML: " : "") << e.msg;
+    throw LabError(where.str());
   }
+}
+
+LabFile parse_yaml(const std::string& text, const std::string& name) {
+  const YAML::Node root = YAML::Load(text);
   LabFile lab;
   lab.path = name;
   Reader top(root, name, "lab file");

@@ -96,6 +96,12 @@ TEST(LabFile, BadValuesAreRefused) {
                 .find("'name' must be a plain name"),
             std::string::npos);
   EXPECT_NE(refusal("lab: [").find("lab.yaml:1:"), std::string::npos);
+  // A list where text belongs (an env value, a key): refused with the place, not yaml-cpp's throw.
+  EXPECT_EQ(refusal("lab: t\nhosts: [{name: a, env: {K: [1, 2]}}]\nprocesses: [{name: p, host: "
+                    "a, run: [x]}]\n")
+                .rfind("lab.yaml:2:", 0),
+            0u);
+  EXPECT_EQ(refusal(lab_text("  - {[a]: 1}\n")).rfind("lab.yaml:", 0), 0u);
   EXPECT_NE(refusal("lab: t\nhosts: []\nprocesses: []\n").find("at least one host"),
             std::string::npos);
 }
