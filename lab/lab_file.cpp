@@ -110,7 +110,8 @@ HostSpec read_host(const YAML::Node& node, const std::string& file) {
   Reader named(node, file, "host '" + h.name + "'");
   named.get("name");
   named.text("hostname", h.hostname);
-  if (h.hostname.empty()) h.hostname = h.name;
+  h.hostname_given = !h.hostname.empty();
+  if (!h.hostname_given) h.hostname = h.name;
   named.text("address", h.address);
   named.text("user", h.user);
   double port = h.port;

@@ -21,7 +21,8 @@
 ///     config: config/stereograsp.yaml  # --config of every stereograsp process (copied)
 ///     hosts:
 ///       - name: lab1                   # how processes name it; also its `hostname` unless
-///         hostname: lab1               #   this says otherwise (PROCESS_STATUS carries it)
+///         hostname: lab1               #   this says otherwise (PROCESS_STATUS carries it;
+///                                      #   a local host: this machine's name)
 ///         address: 10.0.0.1            # "localhost" (the default): run here, without ssh
 ///         user: lab                    # ssh user (default: ssh's own choice)
 ///         port: 22
@@ -56,7 +57,10 @@ class LabError : public std::runtime_error {
 /// One machine of the lab.
 struct HostSpec {
   std::string name;
-  std::string hostname;  ///< what `hostname` prints there (PROCESS_STATUS.host); default: name
+  /// What `hostname` prints there (PROCESS_STATUS.host); default: name, or for a local host
+  /// this machine's own name (LabSession fills it in: hostname_given is false).
+  std::string hostname;
+  bool hostname_given = false;
   std::string address = "localhost";
   std::string user;  ///< "" for ssh's default
   int port = 22;

@@ -93,7 +93,10 @@ LabSession::LabSession(LabFile lab, std::string project, std::ostream& out, std:
     : lab_(std::move(lab)),
       project_(std::move(project)),
       state_(state.empty() ? project_ + "/logs" : std::move(state)),
-      out_(out) {}
+      out_(out) {
+  for (HostSpec& h : lab_.hosts)  // this machine's processes report its own name
+    if (h.local() && !h.hostname_given) h.hostname = this_hostname();
+}
 
 LabSession::~LabSession() = default;
 

@@ -4,11 +4,12 @@
 # addresses, multicast routed over it. Root only. Run it inside `scripts/multicast.sh run` (or
 # another private namespace) so the bridge never touches the machine's own network.
 #
-#   scripts/lab_hosts.sh up DIR [N]        hosts lab1..labN (default 3) at 10.231.0.11.. with an
+#   scripts/lab_hosts.sh up DIR [N] [BUILD]  hosts lab1..labN (default 3) at 10.231.0.11.. with an
 #                                          sshd each; this namespace is 10.231.0.1 on bridge
 #                                          sglab0. DIR gets the ssh key, each host's sshd files, a
-#                                          project folder per host (DIR/labK: build/ and config/
-#                                          linked to this checkout's), and ssh_options.yaml (the
+#                                          project folder per host (DIR/labK: build/ linked to
+#                                          BUILD, default this checkout's build/; config/ copied),
+#                                          and ssh_options.yaml (the
 #                                          lab file's ssh_options for these hosts)
 #   scripts/lab_hosts.sh down DIR          stop the sshds, remove the namespaces and the bridge
 #   scripts/lab_hosts.sh loss HOST PCT     drop PCT % of the UDP datagrams HOST receives
@@ -70,15 +71,16 @@ CONF
 
 # The host's project folder: this checkout's build and config, its own logs and files.
 make_project() {
-  local name=$1 dir=$2
+  local name=$1 dir=$2 build=$3
   mkdir -p "$dir/$name"
-  ln -sfn "$project/build" "$dir/$name/build"
+  ln -sfn "$build" "$dir/$name/build"
   mkdir -p "$dir/$name/config"
   cp "$project/config/stereograsp.yaml" "$dir/$name/config/"
 }
 
 up() {
-  local dir=$1 n=${2:-3}
+  local dir=$1 n=${2:-3} build
+  build=$(cd "${3:-$project/build}" && pwd)
   command -v /usr/sbin/sshd >/dev/null || die "no /usr/sbin/sshd (scripts/bootstrap.sh installs openssh-server)"
   mkdir -p "$dir"
   dir=$(cd "$dir" && pwd)
@@ -92,7 +94,7 @@ up() {
   for k in $(seq 1 "$n"); do
     make_host "lab$k"
     start_sshd "lab$k" "$dir"
-    make_project "lab$k" "$dir"
+    make_project "lab$k" "$dir" "$build"
   done
   cat >"$dir/ssh_options.yaml" <<YAML
 [-i, $dir/lab_key, -o, StrictHostKeyChecking=no, -o, UserKnownHostsFile=/dev/null, -o, LogLevel=ERROR]

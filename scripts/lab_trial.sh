@@ -61,7 +61,7 @@ cleanup() {
 }
 trap cleanup EXIT
 
-scripts/lab_hosts.sh up "$hosts" 3
+scripts/lab_hosts.sh up "$hosts" 3 "$build"
 "$bin/sg-keygen" "$out/lab.key" >/dev/null
 export SG_LAB_KEY=$out/lab.key
 "$bin/sg-camera-sim" --calibration-out "$out/calibration.yaml" --frames 1 --fast \
@@ -73,8 +73,13 @@ if [ "$skew" != 0 ]; then
   faketime_lib=$(dpkg -L libfaketime | grep 'libfaketime.so.1$' | head -1)
   skew_env=", LD_PRELOAD: $faketime_lib, FAKETIME: \"${skew}\", FAKETIME_DONT_FAKE_MONOTONIC: \"1\""
 fi
+# A sanitized build's processes on the hosts report where scripts/test.sh --sanitize looks.
+sanitizer_env=""
+for v in ASAN_OPTIONS UBSAN_OPTIONS LSAN_OPTIONS; do
+  if [ -n "${!v:-}" ]; then sanitizer_env="$sanitizer_env, $v: \"${!v}\""; fi
+done
 host_line() {  # name: its address, folder, key and environment
-  local name=$1 env="SG_LAB_KEY: $out/lab.key"
+  local name=$1 env="SG_LAB_KEY: $out/lab.key$sanitizer_env"
   [ "$name" = "$skew_host" ] && env="$env$skew_env"
   echo "  - {name: $name, address: 10.231.0.$((10 + ${name#lab})), user: root, path: $hosts/$name, ssh_options: $(cat "$hosts/ssh_options.yaml"), env: {$env}}"
 }
