@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <regex>
 #include <set>
 #include <sstream>
 
@@ -100,6 +101,21 @@ bool plain_name(const std::string& s) {
          });
 }
 
+/// `env: {NAME: value}`: a mapping of environment variables, each name a shell variable's.
+void read_env(Reader& r, const std::string& what, std::map<std::string, std::string>& env) {
+  const YAML::Node node = r.get("env");
+  if (!node) return;
+  if (!node.IsMap()) throw r.error(node, what + ": 'env' must be a mapping");
+  static const std::regex kName("[A-Za-z_][A-Za-z0-9_]*");
+  for (const auto& e : node) {
+    const std::string name = e.first.as<std::string>();
+    if (!std::regex_match(name, kName))
+      throw r.error(e.first, what + ": 'env' names a variable '" + name +
+                                 "' (letters, digits and _, not starting with a digit)");
+    env[name] = e.second.as<std::string>();
+  }
+}
+
 HostSpec read_host(const YAML::Node& node, const std::string& file) {
   HostSpec h;
   Reader r(node, file, "host");
@@ -119,10 +135,7 @@ HostSpec read_host(const YAML::Node& node, const std::string& file) {
   h.port = static_cast<int>(port);
   named.text("path", h.path);
   named.list("ssh_options", h.ssh_options);
-  if (const YAML::Node env = named.get("env")) {
-    if (!env.IsMap()) throw named.error(env, "host '" + h.name + "': 'env' must be a mapping");
-    for (const auto& e : env) h.env[e.first.as<std::string>()] = e.second.as<std::string>();
-  }
+  read_env(named, "host '" + h.name + "'", h.env);
   named.done();
   return h;
 }
@@ -160,6 +173,7 @@ ProcessSpec read_process(const YAML::Node& node, const std::string& file) {
   if (p.run.empty() || p.run[0].empty())
     throw named.error(what + ": 'run' must give the program and its arguments, e.g. [sg-vision]");
   named.list("files", p.files);
+  read_env(named, what, p.env);
   p.ready = choice(named, what, "ready", p.stereograsp() ? Readiness::kStatus : Readiness::kStarted,
                    {{"status", Readiness::kStatus}, {"started", Readiness::kStarted}});
   p.restart = choice(named, what, "restart", RestartPolicy::kOnFailure,

@@ -28,12 +28,13 @@
 ///         port: 22
 ///         path: /home/lab/stereograsp  # the project's checkout there (default: this one's)
 ///         ssh_options: [-i, /home/me/.ssh/lab]   # more ssh and scp options
-///         env: {TZ: UTC}               # the environment of its processes
+///         env: {TZ: UTC}               # the environment of everything sg-lab runs there
 ///     processes:                       # started in this order, stopped in the reverse
 ///       - name: driver
 ///         host: lab3
 ///         run: [sg-arm-driver, --device, /tmp/c550, --device-wait, 30]
 ///         files: [calibration.yaml]    # copied to the host (relative to the project)
+///         env: {OMP_NUM_THREADS: 1}    # this process's environment, over its host's
 ///         ready: status                # status | started: when the next may start
 ///         restart: on-failure          # on-failure | always | never
 ///     recorder:                        # lcm-logger, on by default
@@ -89,6 +90,9 @@ struct ProcessSpec {
   std::string host;
   std::vector<std::string> run;  ///< program and arguments; an sg-* program from build/bin/
   std::vector<std::string> files;
+  /// Its environment, over its host's: only the process gets it, not the supervisor or the
+  /// shell commands sg-lab runs on the host.
+  std::map<std::string, std::string> env;
   Readiness ready = Readiness::kStatus;
   RestartPolicy restart = RestartPolicy::kOnFailure;
   int line = 0;  ///< where the file defines it, for messages

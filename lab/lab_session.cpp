@@ -193,7 +193,9 @@ void LabSession::start(const ProcessSpec& p) {
   std::string command = "mkdir -p logs/" + shell_quote(session_) + " && { setsid " +
                         std::string(kBin) + "/sg-lab supervise --name " + shell_quote(p.name) +
                         " --restart " + to_string(p.restart) + " --stop-timeout " +
-                        fixed(lab_.stop_timeout, 3) + " --";
+                        fixed(lab_.stop_timeout, 3);
+  for (const auto& [name, value] : p.env) command += " --env " + shell_quote(name + "=" + value);
+  command += " --";
   for (const std::string& a : argv_of(p)) command += " " + shell_quote(a);
   command += " </dev/null >>" + shell_quote(s.log) + " 2>&1 & echo $!; }";
   const CommandResult r = make_shell(lab_.host(p.host), project_)->run(command, kShellTimeout);

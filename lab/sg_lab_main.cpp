@@ -17,6 +17,7 @@
 
 #include <filesystem>
 #include <iostream>
+#include <regex>
 
 #include "common/program.hpp"
 #include "common/shutdown.hpp"
@@ -60,6 +61,12 @@ CLI::App* add_supervise(CLI::App& app, Options& o) {
                   "s after SIGINT before SIGTERM, and after SIGTERM before SIGKILL")
       ->check(CLI::Range(0.1, 600.0))
       ->capture_default_str();
+  cmd->add_option("--env", o.supervise.env, "NAME=value in the process's environment only")
+      ->allow_extra_args(false)  // one pair a --env: the command stays the command
+      ->check([](const std::string& e) {
+        static const std::regex kPair("[A-Za-z_][A-Za-z0-9_]*=.*");
+        return std::regex_match(e, kPair) ? std::string() : "not NAME=value: " + e;
+      });
   cmd->add_option("command", o.supervise.argv, "the program and its arguments (after --)")
       ->required();
   return cmd;

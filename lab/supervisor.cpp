@@ -41,6 +41,10 @@ pid_t start(const SupervisorOptions& o, const sigset_t& original_mask) {
   const pid_t pid = fork();
   if (pid != 0) return pid;
   sigprocmask(SIG_SETMASK, &original_mask, nullptr);
+  for (const std::string& e : o.env) {  // the supervisor is single-threaded: setenv is safe
+    const size_t eq = e.find('=');
+    if (eq != std::string::npos) setenv(e.substr(0, eq).c_str(), e.c_str() + eq + 1, 1);
+  }
   std::vector<char*> args;
   for (const std::string& a : o.argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);

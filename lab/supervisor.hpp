@@ -32,6 +32,8 @@ namespace sg::lab {
 struct SupervisorOptions {
   std::string name;               ///< the lab's name for the process, for messages
   std::vector<std::string> argv;  ///< program and arguments
+  /// NAME=value pairs set in the process's environment only (the lab file's process `env`).
+  std::vector<std::string> env;
   RestartPolicy restart = RestartPolicy::kOnFailure;
   double stop_timeout = 5;  ///< s after SIGINT before SIGTERM, and after SIGTERM before SIGKILL
   double max_backoff = 30;  ///< s: the restart back-off doubles from 1 s up to this

@@ -62,4 +62,4 @@ expect "$work/skew/hosts/lab2/logs/trial-"*/grasp.log 'capture clock: sg-camera-
   "sg-grasp's correction"
 awk -F'\t' 'NR == 2 && $9 >= 1 { ok = 1 } END { exit !ok }' "$work/skew/results.tsv" ||
   fail "the report's clock warning"
-echo "lab_test: passed: $(sed -n 2p "$work/plain/results.tsv" | cut -f2-9 | tr '\t' ' '); skew: $(sed -n 2p "$work/skew/results.tsv" | cut -f2-9 | tr '\t' ' ')"
+echo "lab_test: passed: $(sed -n 2p "$work/plain/results.tsv" | cut -f2-10 | tr '\t' ' '); skew: $(sed -n 2p "$work/skew/results.tsv" | cut -f2-10 | tr '\t' ' ')"

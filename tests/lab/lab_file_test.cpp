@@ -106,6 +106,29 @@ TEST(LabFile, BadValuesAreRefused) {
             std::string::npos);
 }
 
+// A process's env is its own, beside its host's; a variable name a shell would not take (which
+// sg-lab's commands would otherwise splice into a shell line) is refused, naming it.
+TEST(LabFile, ProcessEnvironment) {
+  const LabFile lab =
+      parse_lab_file(lab_text("  - {name: g, host: here, run: [sg-grasp], env: {FAKETIME: "
+                              "\"-0.8\", OMP_NUM_THREADS: 1}}\n"));
+  const ProcessSpec& g = *lab.process("g");
+  EXPECT_EQ(g.env.size(), 2u);
+  EXPECT_EQ(g.env.at("FAKETIME"), "-0.8");
+  EXPECT_EQ(g.env.at("OMP_NUM_THREADS"), "1");
+  EXPECT_TRUE(lab.process("vision")->env.empty());
+  EXPECT_NE(refusal(lab_text("  - {name: g, host: here, run: [x], env: {\"A; rm -r /\": 1}}\n"))
+                .find("process 'g': 'env' names a variable 'A; rm -r /'"),
+            std::string::npos);
+  EXPECT_NE(refusal("lab: t\nhosts: [{name: a, env: {1X: y}}]\nprocesses: [{name: p, host: a, "
+                    "run: [x]}]\n")
+                .find("host 'a': 'env' names a variable '1X'"),
+            std::string::npos);
+  EXPECT_NE(refusal(lab_text("  - {name: g, host: here, run: [x], env: [A]}\n"))
+                .find("'env' must be a mapping"),
+            std::string::npos);
+}
+
 // `recorder: off` records nothing; a recorder on an unknown host is refused.
 TEST(LabFile, Recorder) {
   EXPECT_FALSE(parse_lab_file(lab_text() + "recorder: off\n").recorder.enabled);

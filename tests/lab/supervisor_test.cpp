@@ -66,6 +66,23 @@ TEST(Supervisor, HangupRestartsAndInterruptStops) {
       << r.err;
 }
 
+// --env sets a variable in the process's environment and not in the supervisor's; a pair without
+// a name is refused before anything starts.
+TEST(Supervisor, EnvironmentIsTheProcesses) {
+  const test::ProcessResult r =
+      test::run({test::program("sg-lab"), "supervise", "--name", "env", "--restart", "never",
+                 "--env", "SG_TEST_SKEW=-0.8 s", "--env", "SG_TEST_EMPTY=", "--", "sh", "-c",
+                 "[ \"$SG_TEST_SKEW\" = '-0.8 s' ] && [ -z \"${SG_TEST_EMPTY-unset}\" ] && "
+                 "tr '\\0' '\\n' < /proc/$PPID/environ | grep -c '^SG_TEST_SKEW=' ; exit 5"},
+                10s);
+  EXPECT_EQ(r.exit_code, 5) << r.err;
+  EXPECT_EQ(r.out, "0\n") << "the supervisor's own environment does not hold it: " << r.err;
+  const test::ProcessResult bad = test::run(
+      {test::program("sg-lab"), "supervise", "--name", "env", "--env", "=x", "--", "true"}, 10s);
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.err.find("not NAME=value: =x"), std::string::npos) << bad.err;
+}
+
 // A process that ignores SIGINT gets SIGTERM after the stop time-out.
 TEST(Supervisor, StopEscalatesToTerm) {
   test::Child s({test::program("sg-lab"), "supervise", "--name", "stubborn", "--stop-timeout",
