@@ -5,21 +5,27 @@
 # grasped, watched, and stopped by `sg-lab down`. Root only; runs in a private network namespace
 # of its own (scripts/multicast.sh run), so nothing reaches the machine's network.
 #
-#   scripts/lab_trial.sh [--runs N] [--track S] [--loss PCT] [--loss-host HOST] [--skew S]
-#                        [--skew-host HOST] [--kill] [--one-host] [--out DIR] [--build-dir DIR]
+#   scripts/lab_trial.sh [--runs N] [--track S] [--loss PCT] [--loss-host HOST] [--loss-for S]
+#                        [--skew S] [--skew-host HOST] [--kill] [--one-host] [--out DIR]
+#                        [--build-dir DIR]
 #
 #   --runs N        grasps, each a fresh `sg-lab up` ... `down` (default 1)
 #   --track S       s of tracking before the grasp command (default 40: the predictor learns)
 #   --loss PCT      drop PCT % of the UDP datagrams --loss-host (default lab2) receives
+#   --loss-for S    ... only for the first S s of tracking, then none (default: the whole trial):
+#                   the loop degrades, then must recover without a restart
 #   --skew S        run --skew-host's (default lab1) processes S seconds off (libfaketime)
 #   --kill          in each run, kill -9 sg-vision on lab1 and time until `sg-lab watch` says so
 #   --one-host      every process on lab1 (the baseline for the latency across hosts)
 #
 # Per run: the time from `sg-lab up` to the first OBJECT_TRAJECTORY (from the session log), the
 # grasp's verdict (sg-grasp-ctl grasp --wait), the camera-to-trajectory latency p50 and p99
-# (sg-report), the clock warnings in the session's report, and how often a start under libfaketime
-# was tried again (below). Writes DIR/results.tsv and DIR/summary.md; exit 0 when every run ran to
-# a verdict.
+# (sg-report), the clock warnings in the session's report, how often a start under libfaketime
+# was tried again (below), the arm motions sg-c550-sim executed and how many of them twice (an MA
+# line identical to an earlier one: the ball moves, so no two genuine targets are equal), the
+# processes' restarts (their supervisors' logs), and with --loss-for sg-predictor's and sg-grasp's
+# messages in per second during the loss and after it (`sg-lab status`). Writes DIR/results.tsv
+# and DIR/summary.md; exit 0 when every run ran to a verdict.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 project=$(pwd)
@@ -30,7 +36,7 @@ if [ -z "${SG_LAB_TRIAL_INSIDE:-}" ]; then
   exec scripts/multicast.sh run env SG_LAB_TRIAL_INSIDE=1 "$0" "$@"
 fi
 
-runs=1 track=40 loss=0 loss_host=lab2 skew=0 skew_host=lab1 kill_vision=0 one_host=0
+runs=1 track=40 loss=0 loss_host=lab2 loss_for="" skew=0 skew_host=lab1 kill_vision=0 one_host=0
 out="logs/$(date +%Y%m%d-%H%M%S)-lab-trial" build=build
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -38,13 +44,14 @@ while [ $# -gt 0 ]; do
     --track) track=$2; shift ;;
     --loss) loss=$2; shift ;;
     --loss-host) loss_host=$2; shift ;;
+    --loss-for) loss_for=$2; shift ;;
     --skew) skew=$2; shift ;;
     --skew-host) skew_host=$2; shift ;;
     --kill) kill_vision=1 ;;
     --one-host) one_host=1 ;;
     --out) out=$2; shift ;;
     --build-dir) build=$2; shift ;;
-    -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,28p' "$0"; exit 0 ;;
     *) echo "$me: unknown option $1 (--help)" >&2; exit 2 ;;
   esac
   shift
@@ -99,7 +106,7 @@ $(host_line lab1)
 $(host_line lab2)
 $(host_line lab3)
 processes:
-  - {name: c550, host: $(on lab3), run: [sg-c550-sim, --link, $out/c550]$(penv $(on lab3))}
+  - {name: c550, host: $(on lab3), run: [sg-c550-sim, --link, $out/c550, --log-commands, $out/c550-commands.tsv]$(penv $(on lab3))}
   - {name: driver, host: $(on lab3), run: [sg-arm-driver, --device, $out/c550, --device-wait, "30"]$(penv $(on lab3))}
   - {name: cameras, host: lab1, run: [sg-camera-sim, --rate, "4"]$(penv lab1)}
   - {name: vision, host: lab1, run: [sg-vision, --calibration, $out/calibration.yaml], files: [$out/calibration.yaml]$(penv lab1)}
@@ -108,12 +115,22 @@ processes:
 recorder: {host: $(on lab2), exclude: CAMERA_.*}
 YAML
 "$bin/sg-lab" --state "$out/state" --lab "$out/lab.yaml" check
-[ "$loss" = 0 ] || scripts/lab_hosts.sh loss "$loss_host" "$loss"
+[ "$loss" = 0 ] || [ -n "$loss_for" ] || scripts/lab_hosts.sh loss "$loss_host" "$loss"
 
 ctl() { "$bin/sg-grasp-ctl" "$@" --lcm-url "$url"; }
+status() { "$bin/sg-lab" --state "$out/state" --lab "$out/lab.yaml" status >"$1" 2>&1 || true; }
+# "predictor/grasp": their messages in per second in a `sg-lab status` (its fixed columns).
+rates_in() {
+  awk '{ n = $1; r = substr($0, 73, 8); gsub(/ /, "", r) }
+       n == "predictor" { p = r } n == "grasp" { g = r } END { print p "/" g }' "$1"
+}
+# "motions<TAB>twice" in sg-c550-sim's command log.
+audit_motions() {
+  awk -F'\t' '$3 ~ /^MA / { n++; if (seen[$3]++) twice++ } END { printf "%d\t%d", n, twice }' "$1"
+}
 now_ms() { date +%s%3N; }
 
-printf 'run\tup_s\tfirst_trajectory_s\theld\tverdict\tlatency_p50_ms\tlatency_p99_ms\tkill_reported_s\tclock_warnings\tfaketime_retries\n' \
+printf 'run\tup_s\tfirst_trajectory_s\theld\tverdict\tlatency_p50_ms\tlatency_p99_ms\tkill_reported_s\tclock_warnings\tfaketime_retries\tmotions\tmotions_twice\trestarts\tin_during_loss\tin_after_loss\n' \
   >"$out/results.tsv"
 for run in $(seq 1 "$runs"); do
   r=$out/run-$run
@@ -155,11 +172,26 @@ for run in $(seq 1 "$runs"); do
     kill -INT "$watcher"; wait "$watcher" || true
   fi
   ctl track >"$r/ctl.txt" 2>&1 || true
-  sleep "$track"
+  rates_loss=- rates_after=-
+  if [ -n "$loss_for" ] && [ "$loss" != 0 ]; then
+    scripts/lab_hosts.sh loss "$loss_host" "$loss"
+    sleep "$(awk -v s="$loss_for" 'BEGIN { print s / 2 }')"
+    status "$r/status-loss.txt"
+    sleep "$(awk -v s="$loss_for" 'BEGIN { print s / 2 }')"
+    scripts/lab_hosts.sh loss "$loss_host" 0
+    sleep "$(awk -v t="$track" -v s="$loss_for" 'BEGIN { print (t > s ? t - s : 0) }')"
+    status "$r/status-recovered.txt"
+    rates_loss=$(rates_in "$r/status-loss.txt") rates_after=$(rates_in "$r/status-recovered.txt")
+  else
+    sleep "$track"
+  fi
   verdict=0
   ctl grasp --wait --timeout 60 >>"$r/ctl.txt" 2>&1 || verdict=$?
-  "$bin/sg-lab" --state "$out/state" --lab "$out/lab.yaml" status >"$r/status-after.txt" 2>&1 || true
+  status "$r/status-after.txt"
   "$bin/sg-lab" --state "$out/state" --lab "$out/lab.yaml" down >"$r/down.txt" 2>&1 || true
+  mv "$out/c550-commands.tsv" "$r/c550-commands.tsv" 2>/dev/null || : >"$r/c550-commands.tsv"
+  motions=$(audit_motions "$r/c550-commands.tsv")
+  restarts=$(cat "$hosts"/lab*/logs/"$session"/*.log 2>/dev/null | grep -c ': .* restarting' || true)
   log=$hosts/$(on lab2)/logs/$session/session.lcmlog
   "$bin/sg-report" "$log" --out "$r/report" --no-plots --quiet >/dev/null 2>&1 || true
   read -r first p50 p99 warnings < <(python3 - "$r/report/report.json" "$t0" <<'PY'
@@ -173,13 +205,14 @@ print(f'{(first - t0) / 1e6:.1f}' if first else "-", f'{lat.get("p50", float("na
 PY
 )
   held=no; [ "$verdict" -eq 0 ] && held=yes
-  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$run" "$up_s" "$first" "$held" "$verdict" \
-    "$p50" "$p99" "$kill_s" "$warnings" "$retries" >>"$out/results.tsv"
-  echo "$me: run $run: up in $up_s s, first trajectory at $first s, held $held, latency p50 $p50 p99 $p99 ms, kill reported ${kill_s} s, clock warnings $warnings"
+  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$run" "$up_s" "$first" \
+    "$held" "$verdict" "$p50" "$p99" "$kill_s" "$warnings" "$retries" "$motions" "$restarts" \
+    "$rates_loss" "$rates_after" >>"$out/results.tsv"
+  echo "$me: run $run: up in $up_s s, first trajectory at $first s, held $held, latency p50 $p50 p99 $p99 ms, kill reported ${kill_s} s, clock warnings $warnings, motions/twice ${motions/$'\t'/\/}, restarts $restarts$([ -n "$loss_for" ] && echo ", in/s predictor/grasp during loss $rates_loss, after $rates_after")"
 done
 held=$(awk -F'\t' 'NR > 1 && $4 == "yes"' "$out/results.tsv" | wc -l)
 {
-  echo "# Lab trial: $runs run(s), loss $loss % on $loss_host, skew $skew s on $skew_host$([ "$one_host" -eq 1 ] && echo ', every process on lab1')"
+  echo "# Lab trial: $runs run(s), loss $loss % on $loss_host$([ -n "$loss_for" ] && echo " for the first $loss_for s of tracking"), skew $skew s on $skew_host$([ "$one_host" -eq 1 ] && echo ', every process on lab1')"
   echo
   echo "held $held of $runs"
   echo

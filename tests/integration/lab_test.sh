@@ -4,7 +4,8 @@
 # three-host lab file (cameras + vision on lab1; predictor + grasp on lab2; driver + C550 emulator
 # on lab3) and runs `sg-lab up`, `status`, `watch`, `down` from a fourth. Checks: every process
 # comes up and `status` lists it ready; sg-vision killed with SIGKILL is reported by `watch` and
-# restarted by its supervisor; the loop tracks and grasps (sg-grasp's verdict is recorded, not
+# restarted by its supervisor, the one restart of the run; sg-c550-sim executed motions and none
+# twice (its command log); the loop tracks and grasps (sg-grasp's verdict is recorded, not
 # insisted on: one grasp at 95 % would fail one run in twenty); `down` stops every process and
 # prints the session's summary. Then once more with lab1's clock 0.8 s behind (libfaketime): the
 # offset is reported by `status` and by the session's report, and sg-grasp puts the forecast on
@@ -50,6 +51,9 @@ expect "$run/down.txt" '^sg-lab: session log: lab2:logs/trial-' "the session log
 expect "$run/down.txt" 'processes: [0-9]+ on 4 host' "the session's summary"
 awk -F'\t' 'NR == 2 && $8 != "-" && $8 <= 3.5 { ok = 1 } END { exit !ok }' \
   "$work/plain/results.tsv" || fail "the kill reported within 3.5 s: $(sed -n 2p "$work/plain/results.tsv")"
+# sg-c550-sim executed motions, none twice; the killed sg-vision was the one restart.
+awk -F'\t' 'NR == 2 && $11 > 0 && $12 == 0 && $13 == 1 { ok = 1 } END { exit !ok }' \
+  "$work/plain/results.tsv" || fail "motions, none twice, one restart: $(sed -n 2p "$work/plain/results.tsv")"
 
 status=0
 "$source_dir/scripts/lab_trial.sh" --build-dir "$build_dir" --runs 1 --track 15 --skew -0.8 \
@@ -62,4 +66,4 @@ expect "$work/skew/hosts/lab2/logs/trial-"*/grasp.log 'capture clock: sg-camera-
   "sg-grasp's correction"
 awk -F'\t' 'NR == 2 && $9 >= 1 { ok = 1 } END { exit !ok }' "$work/skew/results.tsv" ||
   fail "the report's clock warning"
-echo "lab_test: passed: $(sed -n 2p "$work/plain/results.tsv" | cut -f2-10 | tr '\t' ' '); skew: $(sed -n 2p "$work/skew/results.tsv" | cut -f2-10 | tr '\t' ' ')"
+echo "lab_test: passed: $(sed -n 2p "$work/plain/results.tsv" | cut -f2-13 | tr '\t' ' '); skew: $(sed -n 2p "$work/skew/results.tsv" | cut -f2-13 | tr '\t' ' ')"
