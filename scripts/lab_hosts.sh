@@ -24,7 +24,11 @@ me=lab_hosts
 die() { echo "$me: $*" >&2; exit 1; }
 [ "$(id -u)" -eq 0 ] || die "needs root (network namespaces, an sshd per host)"
 
-ns_of() { echo "sg-$1"; }
+# Namespace names are global to the machine: each set of hosts is named after the network
+# namespace it was made from (lab_trial.sh runs in one of its own), so two trials at once (a test
+# and a developer's trial) never meet, and `down` removes only its own.
+ns_prefix="sg-$(stat -L -c %i /proc/self/ns/net)-"
+ns_of() { echo "$ns_prefix$1"; }
 address_of() { echo "10.231.0.$((10 + ${1#lab}))"; }
 
 # One host: a namespace joined to the bridge by a veth pair, loopback and multicast up.
@@ -115,7 +119,7 @@ down() {
   for pidfile in "$dir"/lab*.sshd/pid; do
     [ -e "$pidfile" ] && kill "$(cat "$pidfile")" 2>/dev/null || true
   done
-  for ns in $(ip netns list | awk '/^sg-lab/ {print $1}'); do
+  for ns in $(ip netns list | awk -v p="$ns_prefix" 'index($1, p) == 1 {print $1}'); do
     ip netns pids "$ns" | xargs -r kill -9 2>/dev/null || true
     ip netns del "$ns"
   done
