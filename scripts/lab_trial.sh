@@ -211,10 +211,28 @@ PY
   echo "$me: run $run: up in $up_s s, first trajectory at $first s, held $held, latency p50 $p50 p99 $p99 ms, kill reported ${kill_s} s, clock warnings $warnings, motions/twice ${motions/$'\t'/\/}, restarts $restarts$([ -n "$loss_for" ] && echo ", in/s predictor/grasp during loss $rates_loss, after $rates_after")"
 done
 held=$(awk -F'\t' 'NR > 1 && $4 == "yes"' "$out/results.tsv" | wc -l)
+# Camera-to-trajectory latency over every run's trajectories at once (receive time at the
+# recorder less the capture time, sg-report's CSV): a p99 of a few hundred samples a run is noisy.
+pooled=$(python3 - "$out"/run-*/report/csv/OBJECT_TRAJECTORY.csv <<'PY'
+import csv, sys
+ms = []
+for path in sys.argv[1:]:
+    try:
+        with open(path) as f:
+            ms += [(int(r["recv_utime"]) - int(r["source_utime"])) / 1000 for r in csv.DictReader(f)]
+    except (OSError, KeyError, ValueError):
+        pass
+ms.sort()
+q = lambda p: ms[min(len(ms) - 1, int(p * len(ms)))]
+print(f"{len(ms)} trajectories, p50 {q(0.5):.2f} ms, p99 {q(0.99):.2f} ms" if ms else "no trajectories")
+PY
+)
 {
   echo "# Lab trial: $runs run(s), loss $loss % on $loss_host$([ -n "$loss_for" ] && echo " for the first $loss_for s of tracking"), skew $skew s on $skew_host$([ "$one_host" -eq 1 ] && echo ', every process on lab1')"
   echo
   echo "held $held of $runs"
+  echo
+  echo "camera-to-trajectory latency, every run's trajectories pooled: $pooled"
   echo
   column -t -s $'\t' "$out/results.tsv"
 } >"$out/summary.md"
