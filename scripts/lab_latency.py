@@ -2,7 +2,9 @@
 """Compares the camera-to-trajectory latency of two sets of lab trials (scripts/lab_trial.sh
 --out DIRs), pooling every run's trajectories: p50 and p99 of each, their difference, and a
 bootstrap 95 % interval of the difference (2,000 resamples, seed 1). Latency is the recorder's
-receive time less the capture time, from sg-report's OBJECT_TRAJECTORY.csv of each run.
+receive time less the capture time, from sg-report's OBJECT_TRAJECTORY.csv of each run. The
+interval takes the trajectories as independent: it covers the sampling within the sets, not the
+shift a machine's state gives a whole trial (compare the trials pair by pair for that).
 
   scripts/lab_latency.py --a /work/lat-one-1 /work/lat-one-2 --b /work/lat-three-1 /work/lat-three-2
 """
@@ -17,9 +19,12 @@ def load(dirs):
     ms = []
     for d in dirs:
         for path in sorted(glob.glob(f"{d}/run-*/report/csv/OBJECT_TRAJECTORY.csv")):
-            with open(path) as f:
-                ms += [(int(r["recv_utime"]) - int(r["source_utime"])) / 1000
-                       for r in csv.DictReader(f)]
+            try:
+                with open(path) as f:
+                    ms += [(int(r["recv_utime"]) - int(r["source_utime"])) / 1000
+                           for r in csv.DictReader(f)]
+            except (OSError, KeyError, ValueError) as e:
+                sys.exit(f"lab_latency: {path}: not an sg-report OBJECT_TRAJECTORY.csv ({e!r})")
     return ms
 
 

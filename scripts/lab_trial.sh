@@ -191,7 +191,9 @@ for run in $(seq 1 "$runs"); do
   "$bin/sg-lab" --state "$out/state" --lab "$out/lab.yaml" down >"$r/down.txt" 2>&1 || true
   mv "$out/c550-commands.tsv" "$r/c550-commands.tsv" 2>/dev/null || : >"$r/c550-commands.tsv"
   motions=$(audit_motions "$r/c550-commands.tsv")
-  restarts=$(cat "$hosts"/lab*/logs/"$session"/*.log 2>/dev/null | grep -c ': .* restarting' || true)
+  # The supervisors' own lines (lab/supervisor.hpp), not whatever a process printed.
+  restarts=$(cat "$hosts"/lab*/logs/"$session"/*.log 2>/dev/null |
+    grep -cE '^sg-lab: [A-Za-z0-9_.-]+ (exited with .*; restarting in|restarting on request)' || true)
   log=$hosts/$(on lab2)/logs/$session/session.lcmlog
   "$bin/sg-report" "$log" --out "$r/report" --no-plots --quiet >/dev/null 2>&1 || true
   read -r first p50 p99 warnings < <(python3 - "$r/report/report.json" "$t0" <<'PY'
@@ -220,8 +222,8 @@ for path in sys.argv[1:]:
     try:
         with open(path) as f:
             ms += [(int(r["recv_utime"]) - int(r["source_utime"])) / 1000 for r in csv.DictReader(f)]
-    except (OSError, KeyError, ValueError):
-        pass
+    except (OSError, KeyError, ValueError) as e:  # said, not silently left out of the pool
+        print(f"lab_trial: {path}: left out of the pooled latency: {e!r}", file=sys.stderr)
 ms.sort()
 q = lambda p: ms[min(len(ms) - 1, int(p * len(ms)))]
 print(f"{len(ms)} trajectories, p50 {q(0.5):.2f} ms, p99 {q(0.99):.2f} ms" if ms else "no trajectories")
