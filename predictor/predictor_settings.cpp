@@ -18,6 +18,16 @@ void seconds_key(Section& section, const std::string& key, int64_t& us, const Ra
 
 }  // namespace
 
+bool valid_channel_name(const std::string& name) {
+  if (name.empty() || name.size() > 63) return false;
+  for (const char ch : name) {
+    const bool ok = (ch >= 'A' && ch <= 'Z') || (ch >= 'a' && ch <= 'z') ||
+                    (ch >= '0' && ch <= '9') || ch == '_' || ch == '-' || ch == '.';
+    if (!ok) return false;
+  }
+  return true;
+}
+
 PredictorSettings read_predictor_settings(const Config& config) {
   PredictorSettings s;
   PredictorParams& p = s.params;
@@ -57,6 +67,10 @@ PredictorSettings read_predictor_settings(const Config& config) {
   seconds_key(c, "max_time_offset", g.max_time_offset_us, Range::closed(0, 3600),
               "s: an OBJECT_POSITION whose capture time is farther than this from the receiver's "
               "clock is refused (0: not checked, for replays of old logs)");
+  c.text("output_channel", s.output_channel,
+         "the channel the trajectories go out on (sg-grasp follows OBJECT_TRAJECTORY)");
+  if (!valid_channel_name(s.output_channel))
+    throw c.error("output_channel", "must be 1 to 63 letters, digits, '_', '-' or '.'");
   c.done();
   const arm::Workspace workspace = arm::load_arm_geometry(config).workspace;
   g.box_min = workspace.min;

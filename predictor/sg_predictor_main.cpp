@@ -8,6 +8,7 @@
 //   sg-predictor                                    # Burg, p = 12, W = 480, 4 Hz, H = 16
 //   sg-predictor --model kalman                     # or hold: the baselines
 //   sg-predictor --coefficients coeffs.yaml         # start from offline-trained coefficients
+//   sg-predictor --model kalman --output-channel OBJECT_TRAJECTORY_KALMAN   # a baseline beside
 //   sg-predictor train session.lcmlog --channel GROUND_TRUTH --out coeffs.yaml
 //   sg-predictor train positions.csv --out coeffs.yaml   # lines utime,x,y,z (or t_s,x,y,z)
 
@@ -45,11 +46,12 @@ int run(const std::string& url, const sg::predictor::PredictorSettings& settings
         const sg::predictor::PredictorNode::Output out = node.on_position(m);
         if (!out.refused.empty()) bus.note_refused("OBJECT_POSITION", out.refused);
         if (!out.reset.empty()) spdlog::warn("predictor reset itself: {}", out.reset);
-        for (const auto& t : out.trajectories) bus.publish("OBJECT_TRAJECTORY", t);
+        for (const auto& t : out.trajectories) bus.publish(settings.output_channel, t);
       });
   const PredictorParams& params = settings.params;
-  spdlog::info("predicting with {} (period {} ms, horizon {})",
-               sg::predictor::model_name(params.model), params.period_us / 1000, params.horizon);
+  spdlog::info("predicting with {} (period {} ms, horizon {}) on {}",
+               sg::predictor::model_name(params.model), params.period_us / 1000, params.horizon,
+               settings.output_channel);
   std::string reported = node.status_line();
   double next_report = clock.now() + kStatusPeriod;
   bus.spin([&] {  // the refusals by reason, when they changed, at most every kStatusPeriod
@@ -109,6 +111,7 @@ int main(int argc, char** argv) {
   common.flags.add(app, "--window", "predictor.window", keys);
   common.flags.add(app, "--horizon", "predictor.horizon", keys);
   common.flags.add(app, "--max-time-offset", "predictor.max_time_offset", keys);
+  common.flags.add(app, "--output-channel", "predictor.output_channel", keys);
   std::string input, out, channel = "OBJECT_POSITION";
   CLI::App* train_cmd =
       app.add_subcommand("train", "Train Burg coefficients offline from a log or a CSV");

@@ -3,14 +3,17 @@
 // positions outside the workspace, capture times far from the receiver's clock; each refused and
 // counted, none entering the predictor's history.
 
+#include "predictor/position_gate.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
+#include <string>
+#include <vector>
 
 #include "common/clock.hpp"
 #include "common/config.hpp"
-#include "predictor/position_gate.hpp"
 #include "predictor/predictor_node.hpp"
 #include "predictor/predictor_settings.hpp"
 #include "predictor/trajectory_predictor.hpp"
@@ -260,6 +263,28 @@ TEST(PredictorNode, EachReasonIsCountedAndNothingEntersTheHistory) {
   EXPECT_EQ(node.status_line(),
             "OBJECT_POSITION refused: non-finite 2, outside the workspace 1, time far from now 2, "
             "not after the last 0; predictor resets 0");
+}
+
+// The output channel is OBJECT_TRAJECTORY unless set; a name LCM cannot carry, or one that is
+// empty, is refused naming the key.
+TEST(PredictorSettings, OutputChannelIsCheckedAsAChannelName) {
+  EXPECT_EQ(read_predictor_settings(Config()).output_channel, "OBJECT_TRAJECTORY");
+  EXPECT_EQ(read_predictor_settings(
+                Config::parse("predictor:\n  output_channel: OBJECT_TRAJECTORY_LOCAL\n"))
+                .output_channel,
+            "OBJECT_TRAJECTORY_LOCAL");
+  for (const std::string& bad :
+       std::vector<std::string>{"\"\"", "\"A B\"", "\"A;rm\"", std::string(64, 'A')}) {
+    SCOPED_TRACE(bad);
+    try {
+      read_predictor_settings(Config::parse("predictor:\n  output_channel: " + bad + "\n"));
+      ADD_FAILURE() << "accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("output_channel"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_TRUE(valid_channel_name(std::string(63, 'A')));
+  EXPECT_TRUE(valid_channel_name("BUS_CHECK_point3.t-1"));
 }
 
 }  // namespace
