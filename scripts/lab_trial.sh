@@ -6,8 +6,8 @@
 # of its own (scripts/multicast.sh run), so nothing reaches the machine's network.
 #
 #   scripts/lab_trial.sh [--runs N] [--track S] [--loss PCT] [--loss-host HOST] [--loss-for S]
-#                        [--skew S] [--skew-host HOST] [--kill] [--one-host] [--out DIR]
-#                        [--build-dir DIR]
+#                        [--skew S] [--skew-host HOST] [--kill] [--one-host] [--paired]
+#                        [--out DIR] [--build-dir DIR]
 #
 #   --runs N        grasps, each a fresh `sg-lab up` ... `down` (default 1)
 #   --track S       s of tracking before the grasp command (default 40: the predictor learns)
@@ -17,6 +17,10 @@
 #   --skew S        run --skew-host's (default lab1) processes S seconds off (libfaketime)
 #   --kill          in each run, kill -9 sg-vision on lab1 and time until `sg-lab watch` says so
 #   --one-host      every process on lab1 (the baseline for the latency across hosts)
+#   --paired        the latency across hosts against one host's in the same run: a second
+#                   sg-predictor on lab1 (--output-channel OBJECT_TRAJECTORY_LOCAL) and an
+#                   lcm-logger beside it take the same OBJECT_POSITIONs at the same moments as
+#                   the predictor on lab2, so a machine's state shifts both paths alike
 #
 # Per run: the time from `sg-lab up` to the first OBJECT_TRAJECTORY (from the session log), the
 # grasp's verdict (sg-grasp-ctl grasp --wait), the camera-to-trajectory latency p50 and p99
@@ -24,7 +28,8 @@
 # was tried again (below), the arm motions sg-c550-sim executed and how many of them twice (an MA
 # line identical to an earlier one: the ball moves, so no two genuine targets are equal), the
 # processes' restarts (their supervisors' logs), and with --loss-for sg-predictor's and sg-grasp's
-# messages in per second during the loss and after it (`sg-lab status`). Writes DIR/results.tsv
+# messages in per second during the loss and after it (`sg-lab status`), and with --paired the
+# one-host path's latency p50 and p99 in the same run. Writes DIR/results.tsv
 # and DIR/summary.md; exit 0 when every run ran to a verdict.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -37,6 +42,7 @@ if [ -z "${SG_LAB_TRIAL_INSIDE:-}" ]; then
 fi
 
 runs=1 track=40 loss=0 loss_host=lab2 loss_for="" skew=0 skew_host=lab1 kill_vision=0 one_host=0
+paired=0
 out="logs/$(date +%Y%m%d-%H%M%S)-lab-trial" build=build
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -49,9 +55,10 @@ while [ $# -gt 0 ]; do
     --skew-host) skew_host=$2; shift ;;
     --kill) kill_vision=1 ;;
     --one-host) one_host=1 ;;
+    --paired) paired=1 ;;
     --out) out=$2; shift ;;
     --build-dir) build=$2; shift ;;
-    -h|--help) sed -n '2,28p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,33p' "$0"; exit 0 ;;
     *) echo "$me: unknown option $1 (--help)" >&2; exit 2 ;;
   esac
   shift
@@ -97,6 +104,11 @@ penv() {  # a process's env on host $1: the skew, on the skewed host
   [ -n "$skew_env" ] && [ "$1" = "$skew_host" ] && echo ", env: {$skew_env}"
   true
 }
+paired_processes() {  # --paired: the one-host path beside the three-host one, on lab1
+  [ "$paired" -eq 1 ] || return 0
+  echo "  - {name: predictor-local, host: lab1, run: [sg-predictor, --output-channel, OBJECT_TRAJECTORY_LOCAL]$(penv lab1)}"
+  echo "  - {name: recorder-local, host: lab1, run: [lcm-logger, --quiet, --force, \"--lcm-url=$url\", --channel=OBJECT_TRAJECTORY_LOCAL, $out/local.lcmlog]}"
+}
 cat >"$out/lab.yaml" <<YAML
 lab: trial
 bus: $url
@@ -112,7 +124,8 @@ processes:
   - {name: vision, host: lab1, run: [sg-vision, --calibration, $out/calibration.yaml], files: [$out/calibration.yaml]$(penv lab1)}
   - {name: predictor, host: $(on lab2), run: [sg-predictor]$(penv $(on lab2))}
   - {name: grasp, host: $(on lab2), run: [sg-grasp]$(penv $(on lab2))}
-recorder: {host: $(on lab2), exclude: CAMERA_.*}
+$(paired_processes)
+recorder: {host: $(on lab2), exclude: "CAMERA_.*|OBJECT_TRAJECTORY_LOCAL"}
 YAML
 "$bin/sg-lab" --state "$out/state" --lab "$out/lab.yaml" check
 [ "$loss" = 0 ] || [ -n "$loss_for" ] || scripts/lab_hosts.sh loss "$loss_host" "$loss"
@@ -129,8 +142,24 @@ audit_motions() {
   awk -F'\t' '$3 ~ /^MA / { n++; if (seen[$3]++) twice++ } END { printf "%d\t%d", n, twice }' "$1"
 }
 now_ms() { date +%s%3N; }
+# "p50 p99" in ms of the receive less the capture time in sg-report CSVs; "- -" without any.
+latency_of() {
+  python3 - "$@" <<'PY'
+import csv, sys
+ms = []
+for path in sys.argv[1:]:
+    try:
+        with open(path) as f:
+            ms += [(int(r["recv_utime"]) - int(r["source_utime"])) / 1000 for r in csv.DictReader(f)]
+    except (OSError, KeyError, ValueError) as e:
+        print(f"lab_trial: {path}: no latency from it: {e!r}", file=sys.stderr)
+ms.sort()
+q = lambda p: ms[min(len(ms) - 1, int(p * len(ms)))]
+print(f"{q(0.5):.2f} {q(0.99):.2f}" if ms else "- -")
+PY
+}
 
-printf 'run\tup_s\tfirst_trajectory_s\theld\tverdict\tlatency_p50_ms\tlatency_p99_ms\tkill_reported_s\tclock_warnings\tfaketime_retries\tmotions\tmotions_twice\trestarts\tin_during_loss\tin_after_loss\n' \
+printf 'run\tup_s\tfirst_trajectory_s\theld\tverdict\tlatency_p50_ms\tlatency_p99_ms\tkill_reported_s\tclock_warnings\tfaketime_retries\tmotions\tmotions_twice\trestarts\tin_during_loss\tin_after_loss\tlocal_p50_ms\tlocal_p99_ms\n' \
   >"$out/results.tsv"
 for run in $(seq 1 "$runs"); do
   r=$out/run-$run
@@ -206,11 +235,17 @@ print(f'{(first - t0) / 1e6:.1f}' if first else "-", f'{lat.get("p50", float("na
       f'{lat.get("p99", float("nan")):.2f}', len(j["processes"]["clock_warnings"]))
 PY
 )
+  local_p50=- local_p99=-
+  if [ "$paired" -eq 1 ]; then
+    mv "$out/local.lcmlog" "$r/local.lcmlog" 2>/dev/null || true
+    "$bin/sg-report" "$r/local.lcmlog" --out "$r/report-local" --no-plots --quiet >/dev/null 2>&1 || true
+    read -r local_p50 local_p99 < <(latency_of "$r/report-local/csv/OBJECT_TRAJECTORY_LOCAL.csv")
+  fi
   held=no; [ "$verdict" -eq 0 ] && held=yes
-  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$run" "$up_s" "$first" \
-    "$held" "$verdict" "$p50" "$p99" "$kill_s" "$warnings" "$retries" "$motions" "$restarts" \
-    "$rates_loss" "$rates_after" >>"$out/results.tsv"
-  echo "$me: run $run: up in $up_s s, first trajectory at $first s, held $held, latency p50 $p50 p99 $p99 ms, kill reported ${kill_s} s, clock warnings $warnings, motions/twice ${motions/$'\t'/\/}, restarts $restarts$([ -n "$loss_for" ] && echo ", in/s predictor/grasp during loss $rates_loss, after $rates_after")"
+  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$run" "$up_s" \
+    "$first" "$held" "$verdict" "$p50" "$p99" "$kill_s" "$warnings" "$retries" "$motions" \
+    "$restarts" "$rates_loss" "$rates_after" "$local_p50" "$local_p99" >>"$out/results.tsv"
+  echo "$me: run $run: up in $up_s s, first trajectory at $first s, held $held, latency p50 $p50 p99 $p99 ms, kill reported ${kill_s} s, clock warnings $warnings, motions/twice ${motions/$'\t'/\/}, restarts $restarts$([ -n "$loss_for" ] && echo ", in/s predictor/grasp during loss $rates_loss, after $rates_after")$([ "$paired" -eq 1 ] && echo ", one-host path p50 $local_p50 p99 $local_p99")"
 done
 held=$(awk -F'\t' 'NR > 1 && $4 == "yes"' "$out/results.tsv" | wc -l)
 # Camera-to-trajectory latency over every run's trajectories at once (receive time at the
@@ -235,6 +270,12 @@ PY
   echo "held $held of $runs"
   echo
   echo "camera-to-trajectory latency, every run's trajectories pooled: $pooled"
+  if [ "$paired" -eq 1 ]; then
+    echo
+    echo "the same trajectories across hosts and on one host (scripts/lab_latency.py --paired):"
+    echo
+    scripts/lab_latency.py --paired "$out" 2>&1 | sed 's/^/    /'
+  fi
   echo
   column -t -s $'\t' "$out/results.tsv"
 } >"$out/summary.md"

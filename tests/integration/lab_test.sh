@@ -5,7 +5,8 @@
 # on lab3) and runs `sg-lab up`, `status`, `watch`, `down` from a fourth. Checks: every process
 # comes up and `status` lists it ready; sg-vision killed with SIGKILL is reported by `watch` and
 # restarted by its supervisor, the one restart of the run; sg-c550-sim executed motions and none
-# twice (its command log); the loop tracks and grasps (sg-grasp's verdict is recorded, not
+# twice (its command log); a second sg-predictor and lcm-logger on lab1 (--paired) give the
+# one-host path's latency beside the path across hosts; the loop tracks and grasps (sg-grasp's verdict is recorded, not
 # insisted on: one grasp at 95 % would fail one run in twenty); `down` stops every process and
 # prints the session's summary. Then once more with lab1's clock 0.8 s behind (libfaketime): the
 # offset is reported by `status` and by the session's report, and sg-grasp puts the forecast on
@@ -34,19 +35,19 @@ expect() {  # FILE PATTERN WHAT
 }
 
 status=0
-"$source_dir/scripts/lab_trial.sh" --build-dir "$build_dir" --runs 1 --track 15 --kill \
+"$source_dir/scripts/lab_trial.sh" --build-dir "$build_dir" --runs 1 --track 15 --kill --paired \
   --out "$work/plain" || status=$?
 [ "$status" -eq 0 ] || fail "lab_trial.sh exited $status"
 run=$work/plain/run-1
-expect "$run/up.txt" '^sg-lab: up in [0-9.]+ s: 6 processes on 3 host' "sg-lab up"
-for p in c550 driver cameras vision predictor grasp; do
+expect "$run/up.txt" '^sg-lab: up in [0-9.]+ s: 8 processes on 3 host' "sg-lab up"
+for p in c550 driver cameras vision predictor grasp predictor-local; do
   expect "$run/status.txt" "^$p +lab[123] +sg-[a-z0-9-]+ +[0-9]+ ready " "$p ready in status"
 done
 expect "$run/status.txt" '^recorder +lab2 +lcm-logger +- running' "the recorder running"
 expect "$run/watch.txt" 'sg-vision@lab1:[0-9]+ stopped beating' "the killed sg-vision reported"
 expect "$run/status-after.txt" '^vision +lab1 +sg-vision +[0-9]+ ready' "sg-vision restarted"
 expect "$run/ctl.txt" 'grasp' "a grasp asked"
-[ "$(grep -c ' stopped on lab[123] in ' "$run/down.txt")" -eq 7 ] || fail "down stopped 7"
+[ "$(grep -c ' stopped on lab[123] in ' "$run/down.txt")" -eq 9 ] || fail "down stopped 9"
 expect "$run/down.txt" '^sg-lab: session log: lab2:logs/trial-' "the session log"
 expect "$run/down.txt" 'processes: [0-9]+ on 4 host' "the session's summary"
 awk -F'\t' 'NR == 2 && $8 != "-" && $8 <= 3.5 { ok = 1 } END { exit !ok }' \
@@ -54,6 +55,11 @@ awk -F'\t' 'NR == 2 && $8 != "-" && $8 <= 3.5 { ok = 1 } END { exit !ok }' \
 # sg-c550-sim executed motions, none twice; the killed sg-vision was the one restart.
 awk -F'\t' 'NR == 2 && $11 > 0 && $12 == 0 && $13 == 1 { ok = 1 } END { exit !ok }' \
   "$work/plain/results.tsv" || fail "motions, none twice, one restart: $(sed -n 2p "$work/plain/results.tsv")"
+# --paired: the one-host path's latency beside the path across hosts, the same trajectories.
+awk -F'\t' 'NR == 2 && $16 > 0 && $16 < 1000 { ok = 1 } END { exit !ok }' \
+  "$work/plain/results.tsv" || fail "the one-host path's p99: $(sed -n 2p "$work/plain/results.tsv")"
+expect "$work/plain/summary.md" 'pooled: [0-9]+ pairs; across hosts p50 [0-9.]+ p99 [0-9.]+ ms; one host' \
+  "the paired latency"
 
 status=0
 "$source_dir/scripts/lab_trial.sh" --build-dir "$build_dir" --runs 1 --track 15 --skew -0.8 \
