@@ -36,6 +36,7 @@ packages=(
   libopencv-dev                                    # images, video files, calibration
   opencv-doc                                       # real photographs and video (real-scene tests)
   libturbojpeg0-dev                                # a JPEG's size from its header, before decoding
+  libjpeg62-turbo-dev                              # libjpeg API: decode only a search window
   libgtest-dev libgmock-dev libbenchmark-dev       # tests and benchmarks
   nlohmann-json3-dev                               # sg-report's report.json (and its tests)
   libsodium-dev pkg-config                         # signed commands (auth/: HMAC, the lab key)

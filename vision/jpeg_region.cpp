@@ -1,0 +1,127 @@
+#include "vision/jpeg_region.hpp"
+
+// clang-format off
+#include <cstdio>   // jpeglib.h needs FILE and size_t first
+#include <jpeglib.h>
+// clang-format on
+
+#include <algorithm>
+#include <csetjmp>
+
+namespace sg::vision {
+namespace {
+
+/// libjpeg's error manager, extended with where to jump to instead of exit().
+struct ErrorManager {
+  jpeg_error_mgr pub;
+  std::jmp_buf jump;
+  char message[JMSG_LENGTH_MAX];
+  uint64_t warnings;
+};
+
+[[noreturn]] void on_error(j_common_ptr cinfo) {
+  auto* e = reinterpret_cast<ErrorManager*>(cinfo->err);
+  (*cinfo->err->format_message)(cinfo, e->message);
+  std::longjmp(e->jump, 1);
+}
+
+void on_message(j_common_ptr cinfo, int level) {  // never printed: counted
+  if (level < 0) ++reinterpret_cast<ErrorManager*>(cinfo->err)->warnings;
+}
+
+/// A progressive JPEG with more than kMaxScans scans is refused as it is read.
+void on_progress(j_common_ptr cinfo) {
+  auto* d = reinterpret_cast<j_decompress_ptr>(cinfo);
+  if (d->progressive_mode && d->input_scan_number > JpegRegionDecoder::kMaxScans) {
+    auto* e = reinterpret_cast<ErrorManager*>(cinfo->err);
+    std::snprintf(e->message, sizeof e->message, "progressive JPEG with more than %d scans",
+                  JpegRegionDecoder::kMaxScans);
+    std::longjmp(e->jump, 1);
+  }
+}
+
+/// `region` clipped to the image and widened by `mx`, `my` px on each side (empty: all of it).
+cv::Rect widened(cv::Rect region, cv::Size size, int mx, int my) {
+  const cv::Rect all(0, 0, size.width, size.height);
+  region &= all;
+  if (region.empty()) return all;
+  const int x0 = std::max(0, region.x - mx), y0 = std::max(0, region.y - my);
+  const int x1 = std::min(size.width, region.br().x + mx);
+  const int y1 = std::min(size.height, region.br().y + my);
+  return {x0, y0, x1 - x0, y1 - y0};
+}
+
+}  // namespace
+
+struct JpegRegionDecoder::State {
+  jpeg_decompress_struct cinfo{};
+  ErrorManager error{};
+  jpeg_progress_mgr progress{};
+};
+
+JpegRegionDecoder::JpegRegionDecoder() : state_(std::make_unique<State>()) {
+  jpeg_decompress_struct& c = state_->cinfo;
+  c.err = jpeg_std_error(&state_->error.pub);
+  state_->error.pub.error_exit = on_error;
+  state_->error.pub.emit_message = on_message;
+  jpeg_create_decompress(&c);  // cannot fail short of memory, which on_error would not survive
+  state_->progress.progress_monitor = on_progress;
+  c.progress = &state_->progress;
+}
+
+JpegRegionDecoder::~JpegRegionDecoder() { jpeg_destroy_decompress(&state_->cinfo); }
+
+uint64_t JpegRegionDecoder::warnings() const { return state_->error.warnings; }
+
+JpegRegionDecoder::Result JpegRegionDecoder::decode(const uint8_t* data, size_t bytes,
+                                                    cv::Size size, cv::Rect region,
+                                                    cv::Mat& bgr) {
+  Result r;
+  if (data == nullptr || bytes == 0) {
+    r.error = "empty JPEG";
+    return r;
+  }
+  if (bgr.type() != CV_8UC3 || bgr.size() != size) bgr.create(size, CV_8UC3);
+  jpeg_decompress_struct& c = state_->cinfo;
+  // Only plain data lives across the setjmp: nothing with a destructor is skipped by longjmp.
+  if (setjmp(state_->error.jump)) {
+    jpeg_abort_decompress(&c);
+    r.error = std::string("JPEG does not decode: ") + state_->error.message;
+    return r;
+  }
+  jpeg_mem_src(&c, data, static_cast<unsigned long>(bytes));
+  jpeg_read_header(&c, TRUE);
+  if (static_cast<int>(c.image_width) != size.width ||
+      static_cast<int>(c.image_height) != size.height) {
+    r.error = "JPEG header declares " + std::to_string(c.image_width) + "x" +
+              std::to_string(c.image_height) + ", the message " + std::to_string(size.width) +
+              "x" + std::to_string(size.height);
+    jpeg_abort_decompress(&c);
+    return r;
+  }
+  c.out_color_space = JCS_EXT_BGR;
+  jpeg_start_decompress(&c);
+  // One iMCU more on every side: the upsampling of the region's edge reads its neighbours.
+  const cv::Rect want = widened(region, size, c.max_h_samp_factor * DCTSIZE,
+                                c.max_v_samp_factor * DCTSIZE);
+  JDIMENSION x = static_cast<JDIMENSION>(want.x), width = static_cast<JDIMENSION>(want.width);
+  if (want.width < size.width) jpeg_crop_scanline(&c, &x, &width);  // x moves left to an iMCU
+  if (want.y > 0) jpeg_skip_scanlines(&c, static_cast<JDIMENSION>(want.y));
+  while (static_cast<int>(c.output_scanline) < want.br().y) {
+    JSAMPROW row = bgr.ptr<uint8_t>(static_cast<int>(c.output_scanline)) + 3 * x;
+    if (jpeg_read_scanlines(&c, &row, 1) != 1) {  // cannot happen with a memory source
+      jpeg_abort_decompress(&c);
+      r.error = "JPEG decoder gave no scanline";
+      return r;
+    }
+  }
+  if (c.output_scanline == c.output_height)
+    jpeg_finish_decompress(&c);
+  else
+    jpeg_abort_decompress(&c);
+  r.ok = true;
+  r.decoded = cv::Rect(static_cast<int>(x), want.y, static_cast<int>(width), want.height);
+  return r;
+}
+
+}  // namespace sg::vision
