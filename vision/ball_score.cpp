@@ -16,7 +16,8 @@ double shape_cost(const Candidate& c, const ScoringParams& p) {
   if (support < p.min_support / 2) return p.max_cost + 1;  // no circle in its outline
   if (support < p.min_support) cost += square((p.min_support - support) / 0.1);
   if (support >= p.fit_below_support && c.blob.minor_axis > 0) {
-    const double excess = std::log(c.blob.major_axis / c.blob.minor_axis) - std::log(p.max_axis_ratio);
+    const double excess =
+        std::log(c.blob.major_axis / c.blob.minor_axis) - std::log(p.max_axis_ratio);
     if (excess > 0) cost += square(excess / p.axis_ratio_scale);
   }
   return cost;

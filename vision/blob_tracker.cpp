@@ -113,6 +113,14 @@ Candidate BlobTracker::describe(const Region& region) {
   return c;
 }
 
+cv::Rect BlobTracker::next_window(const std::optional<cv::Point2d>& predicted) const {
+  const cv::Rect all(0, 0, size_.width, size_.height);
+  if (!has_track_ || misses_ >= params_.window.misses_before_full_frame) return all;
+  const cv::Rect w = search_window(predicted.value_or(last_centre_), last_diameter_, misses_, size_,
+                                   params_.window);
+  return w.empty() ? all : w;  // empty: the prediction left the image, search it all
+}
+
 Detection BlobTracker::detect(const cv::Mat& bgr, const std::optional<cv::Point2d>& predicted,
                               const std::optional<double>& expected_radius) {
   if (bgr.type() != CV_8UC3 || bgr.size() != size_)
@@ -123,14 +131,8 @@ Detection BlobTracker::detect(const cv::Mat& bgr, const std::optional<cv::Point2
   d.image = bgr;
   Observation& o = d.frame;
   o.misses = misses_;
-  o.tracking = has_track_ && misses_ < params_.window.misses_before_full_frame;
-  o.window = o.tracking ? search_window(predicted.value_or(last_centre_), last_diameter_, misses_,
-                                        size_, params_.window)
-                        : cv::Rect(0, 0, size_.width, size_.height);
-  if (o.window.empty()) {  // the prediction left the image: search it all
-    o.tracking = false;
-    o.window = cv::Rect(0, 0, size_.width, size_.height);
-  }
+  o.window = next_window(predicted);
+  o.tracking = o.window != cv::Rect(0, 0, size_.width, size_.height);
   int min_area = params_.min_area;
   if (has_track_ && misses_ < params_.forget_size_after_misses) {
     min_area = std::max(min_area, static_cast<int>(params_.min_area_fraction_of_last * last_area_));
@@ -185,7 +187,11 @@ void BlobTracker::learn_clutter(const Detection& d, int index) {
 void BlobTracker::learn_colour(const Detection& d, const Candidate& ball, double confidence) {
   if (confidence < 0.5 || !(ball.whole_disc || ball.support >= 0.8)) return;
   colour_.add(ball.mean_r, ball.mean_g);
-  if (!ball.fitted && !d.image.empty() && adaptation_.learn(d.image, ball.centre, ball.radius))
+  if (ball.fitted || d.image.empty()) return;
+  // Only the window's pixels: they are all a region decode of the frame holds (jpeg_region.hpp).
+  const cv::Rect& w = d.frame.window;
+  const cv::Point2d centre = ball.centre - cv::Point2d(w.x, w.y);
+  if (adaptation_.learn(d.image(w), centre, ball.radius))
     detector_ = ColorDetector(adaptation_.thresholds());
 }
 

@@ -107,6 +107,9 @@ class BlobTracker {
   /// the last image's size in the score.
   Detection detect(const cv::Mat& bgr, const std::optional<cv::Point2d>& predicted = std::nullopt,
                    const std::optional<double>& expected_radius = std::nullopt);
+  /// The pixels the next detect() with `predicted` reads: the search window while tracking, else
+  /// the whole image. Nothing outside it is read, so a caller may decode only it (jpeg_region.hpp).
+  cv::Rect next_window(const std::optional<cv::Point2d>& predicted = std::nullopt) const;
   /// Takes candidate `index` of `d` as the ball (-1: a miss) and updates the track.
   Observation accept(const Detection& d, int index);
 

@@ -11,8 +11,8 @@
 ///     if (auto m = model.estimate()) context.colour = m;  // mu_r, sigma_r, mu_g, sigma_g
 
 #include <cmath>
-#include <optional>
 #include <opencv2/core.hpp>
+#include <optional>
 
 namespace sg::vision {
 

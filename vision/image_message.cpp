@@ -48,41 +48,57 @@ image_t encode_image(const cv::Mat& bgr, int8_t camera, int64_t frame_number, in
   return msg;
 }
 
-std::optional<cv::Mat> decode_image(const image_t& m, std::string* error) {
-  auto fail = [&](const std::string& what) -> std::optional<cv::Mat> {
-    if (error) *error = what;
-    return std::nullopt;
-  };
+namespace {
+
+/// Bytes a pixel takes in a raw format; 0 for JPEG or an unknown format.
+int raw_channels(int format) {
+  if (format == image_t::FORMAT_GRAY8) return 1;
+  if (format == image_t::FORMAT_BGR8 || format == image_t::FORMAT_RGB8) return 3;
+  return 0;
+}
+
+}  // namespace
+
+std::string image_message_error(const image_t& m) {
   if (m.width <= 0 || m.height <= 0 || static_cast<int64_t>(m.width) * m.height > kMaxImagePixels)
-    return fail("image size " + std::to_string(m.width) + "x" + std::to_string(m.height) +
-                " is not valid (at most " + std::to_string(kMaxImagePixels) + " pixels)");
-  if (m.size != static_cast<int32_t>(m.data.size()))
-    return fail("size field does not match the data");
+    return "image size " + std::to_string(m.width) + "x" + std::to_string(m.height) +
+           " is not valid (at most " + std::to_string(kMaxImagePixels) + " pixels)";
+  if (m.size != static_cast<int32_t>(m.data.size())) return "size field does not match the data";
   if (m.pixel_format == image_t::FORMAT_JPEG) {
     const auto declared = jpeg_declared_size(m.data);
-    if (!declared) return fail("JPEG header does not decode");
-    if (declared->first != m.width || declared->second != m.height) {
-      return fail("JPEG header declares " + std::to_string(declared->first) + "x" +
-                  std::to_string(declared->second) + ", the message " + std::to_string(m.width) +
-                  "x" + std::to_string(m.height));
-    }
+    if (!declared) return "JPEG header does not decode";
+    if (declared->first != m.width || declared->second != m.height)
+      return "JPEG header declares " + std::to_string(declared->first) + "x" +
+             std::to_string(declared->second) + ", the message " + std::to_string(m.width) + "x" +
+             std::to_string(m.height);
+    return "";
+  }
+  const int channels = raw_channels(m.pixel_format);
+  if (channels == 0) return "unknown pixel_format " + std::to_string(m.pixel_format);
+  if (m.row_stride < m.width * channels ||
+      static_cast<int64_t>(m.row_stride) * m.height > static_cast<int64_t>(m.data.size()))
+    return std::to_string(m.width) + "x" + std::to_string(m.height) + " with row_stride " +
+           std::to_string(m.row_stride) + " needs more than the " + std::to_string(m.data.size()) +
+           " bytes it holds";
+  return "";
+}
+
+std::optional<cv::Mat> decode_image(const image_t& m, std::string* error) {
+  if (std::string e = image_message_error(m); !e.empty()) {
+    if (error) *error = std::move(e);
+    return std::nullopt;
+  }
+  if (m.pixel_format == image_t::FORMAT_JPEG) {
     cv::Mat bgr = cv::imdecode(m.data, cv::IMREAD_COLOR);
-    if (bgr.empty()) return fail("JPEG data does not decode");
-    if (bgr.cols != m.width || bgr.rows != m.height)
-      return fail("JPEG size differs from width x height");
+    if (bgr.empty() || bgr.cols != m.width || bgr.rows != m.height) {
+      if (error)
+        *error =
+            bgr.empty() ? "JPEG data does not decode" : "JPEG size differs from width x height";
+      return std::nullopt;
+    }
     return bgr;
   }
-  const int channels =
-      m.pixel_format == image_t::FORMAT_GRAY8                                              ? 1
-      : (m.pixel_format == image_t::FORMAT_BGR8 || m.pixel_format == image_t::FORMAT_RGB8) ? 3
-                                                                                           : 0;
-  if (channels == 0) return fail("unknown pixel_format " + std::to_string(m.pixel_format));
-  if (m.row_stride < m.width * channels ||
-      static_cast<int64_t>(m.row_stride) * m.height > static_cast<int64_t>(m.data.size())) {
-    return fail(std::to_string(m.width) + "x" + std::to_string(m.height) + " with row_stride " +
-                std::to_string(m.row_stride) + " needs more than the " +
-                std::to_string(m.data.size()) + " bytes it holds");
-  }
+  const int channels = raw_channels(m.pixel_format);
   const cv::Mat view(m.height, m.width, channels == 1 ? CV_8U : CV_8UC3,
                      const_cast<uint8_t*>(m.data.data()), static_cast<size_t>(m.row_stride));
   cv::Mat bgr;

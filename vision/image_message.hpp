@@ -17,6 +17,12 @@ stereograsp::image_t encode_image(const cv::Mat& bgr, int8_t camera, int64_t fra
 /// anything is allocated for them.
 constexpr int64_t kMaxImagePixels = int64_t{4096} * 4096;
 
+/// What is wrong with an image_t before it is decoded ("" when nothing): a size of no pixels or
+/// more than kMaxImagePixels, a `size` other than the data's, a JPEG whose header does not read or
+/// declares another size, an unknown format, raw rows that need more bytes than it holds. Cheap
+/// (a JPEG's header only), so a bad image is refused as it arrives.
+std::string image_message_error(const stereograsp::image_t& message);
+
 /// The BGR frame in an image_t, or nullopt with `error` saying what is wrong (a size that does
 /// not match the data, an unknown format, more than kMaxImagePixels, a JPEG whose header
 /// declares another size than the message, a JPEG that does not decode). A JPEG's size is read

@@ -74,8 +74,7 @@ JpegRegionDecoder::~JpegRegionDecoder() { jpeg_destroy_decompress(&state_->cinfo
 uint64_t JpegRegionDecoder::warnings() const { return state_->error.warnings; }
 
 JpegRegionDecoder::Result JpegRegionDecoder::decode(const uint8_t* data, size_t bytes,
-                                                    cv::Size size, cv::Rect region,
-                                                    cv::Mat& bgr) {
+                                                    cv::Size size, cv::Rect region, cv::Mat& bgr) {
   Result r;
   if (data == nullptr || bytes == 0) {
     r.error = "empty JPEG";
@@ -94,16 +93,16 @@ JpegRegionDecoder::Result JpegRegionDecoder::decode(const uint8_t* data, size_t 
   if (static_cast<int>(c.image_width) != size.width ||
       static_cast<int>(c.image_height) != size.height) {
     r.error = "JPEG header declares " + std::to_string(c.image_width) + "x" +
-              std::to_string(c.image_height) + ", the message " + std::to_string(size.width) +
-              "x" + std::to_string(size.height);
+              std::to_string(c.image_height) + ", the message " + std::to_string(size.width) + "x" +
+              std::to_string(size.height);
     jpeg_abort_decompress(&c);
     return r;
   }
   c.out_color_space = JCS_EXT_BGR;
   jpeg_start_decompress(&c);
   // One iMCU more on every side: the upsampling of the region's edge reads its neighbours.
-  const cv::Rect want = widened(region, size, c.max_h_samp_factor * DCTSIZE,
-                                c.max_v_samp_factor * DCTSIZE);
+  const cv::Rect want =
+      widened(region, size, c.max_h_samp_factor * DCTSIZE, c.max_v_samp_factor * DCTSIZE);
   JDIMENSION x = static_cast<JDIMENSION>(want.x), width = static_cast<JDIMENSION>(want.width);
   if (want.width < size.width) jpeg_crop_scanline(&c, &x, &width);  // x moves left to an iMCU
   if (want.y > 0) jpeg_skip_scanlines(&c, static_cast<JDIMENSION>(want.y));

@@ -76,7 +76,8 @@ void Segmenter::label_window(const cv::Mat& bgr, const ColorDetector& detector) 
       if (label == 0) {
         label = next_++;
         parent_[static_cast<size_t>(label)] = label;
-        sums_[static_cast<size_t>(label)] = Region{{}, w.x + x, w.y + y, w.x + x, w.y + y, 0, 0, 0, label};
+        sums_[static_cast<size_t>(label)] =
+            Region{{}, w.x + x, w.y + y, w.x + x, w.y + y, 0, 0, 0, label};
       }
       row[x] = label;
       add_pixel(sums_[static_cast<size_t>(label)], w.x + x, w.y + y, in);
@@ -88,7 +89,8 @@ void Segmenter::label_window(const cv::Mat& bgr, const ColorDetector& detector) 
 // each provisional label's sums then go to its root.
 void Segmenter::sum_regions() {
   for (int32_t i = 1; i < next_; ++i) {
-    const size_t p = static_cast<size_t>(parent_[static_cast<size_t>(parent_[static_cast<size_t>(i)])]);
+    const size_t p =
+        static_cast<size_t>(parent_[static_cast<size_t>(parent_[static_cast<size_t>(i)])]);
     parent_[static_cast<size_t>(i)] = static_cast<int32_t>(p);
     if (p != static_cast<size_t>(i)) merge(sums_[p], sums_[static_cast<size_t>(i)]);
   }
@@ -100,7 +102,8 @@ void Segmenter::keep_candidate(Segmentation& s, const Region& region) const {
   while (at > 0 && s.regions[static_cast<size_t>(at - 1)].moments.m00 < region.moments.m00) --at;
   if (at >= Segmentation::kMaxRegions) return;
   const int last = std::min(s.num_candidates, Segmentation::kMaxRegions - 1);
-  for (int k = last; k > at; --k) s.regions[static_cast<size_t>(k)] = s.regions[static_cast<size_t>(k - 1)];
+  for (int k = last; k > at; --k)
+    s.regions[static_cast<size_t>(k)] = s.regions[static_cast<size_t>(k - 1)];
   s.regions[static_cast<size_t>(at)] = region;
   s.num_candidates = std::min(s.num_candidates + 1, Segmentation::kMaxRegions);
 }
@@ -127,14 +130,16 @@ Segmentation Segmenter::run(const cv::Mat& bgr, const cv::Rect& window,
 }
 
 cv::Mat Segmenter::mask_of(const Region& region) {
-  const cv::Rect box = (cv::Rect(region.x_min - 1, region.y_min - 1, region.x_max - region.x_min + 3,
-                                 region.y_max - region.y_min + 3)) &
-                       window_;
+  const cv::Rect box =
+      (cv::Rect(region.x_min - 1, region.y_min - 1, region.x_max - region.x_min + 3,
+                region.y_max - region.y_min + 3)) &
+      window_;
   mask_origin_ = box.tl();
   cv::Mat mask(box.height, box.width, CV_8UC1, mask_.data());
   if (box.empty()) return mask;
   for (int y = 0; y < box.height; ++y) {
-    const int32_t* row = labels_.data() + static_cast<size_t>(box.y - window_.y + y) * window_.width +
+    const int32_t* row = labels_.data() +
+                         static_cast<size_t>(box.y - window_.y + y) * window_.width +
                          (box.x - window_.x);
     uint8_t* out = mask.ptr<uint8_t>(y);
     for (int x = 0; x < box.width; ++x) {

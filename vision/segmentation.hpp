@@ -12,10 +12,10 @@ namespace sg::vision {
 
 /// One 8-connected region of the object's colour: a candidate for the ball.
 struct Region {
-  RawMoments moments;                          ///< eq. 9, image coordinates
+  RawMoments moments;                                ///< eq. 9, image coordinates
   int x_min = 0, y_min = 0, x_max = -1, y_max = -1;  ///< the pixels' extent, image coordinates
-  int64_t sum_b = 0, sum_g = 0, sum_r = 0;     ///< colour sums over its pixels
-  int32_t label = 0;                           ///< its root label, until the next run()
+  int64_t sum_b = 0, sum_g = 0, sum_r = 0;           ///< colour sums over its pixels
+  int32_t label = 0;                                 ///< its root label, until the next run()
 
   /// The pixels' bounding box.
   cv::Rect box() const { return {x_min, y_min, x_max - x_min + 1, y_max - y_min + 1}; }
@@ -36,9 +36,9 @@ struct Segmentation {
 };
 
 /// Detection (eq. 7-8), connected-component labelling and the sums of every region (raw
-/// moments, extent, colour) in one pass over a window, merged per region after it: the largest regions are the
-/// candidates, the largest the paper's target. Buffers are sized once for the largest window, so
-/// tracking allocates nothing per frame.
+/// moments, extent, colour) in one pass over a window, merged per region after it: the largest
+/// regions are the candidates, the largest the paper's target. Buffers are sized once for the
+/// largest window, so tracking allocates nothing per frame.
 ///
 ///     Segmenter segmenter(image_size);
 ///     Segmentation s = segmenter.run(bgr, window, detector, /*min_area=*/30);

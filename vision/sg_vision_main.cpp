@@ -20,10 +20,12 @@
 
 #include "common/bus.hpp"
 #include "common/clock.hpp"
+#include "common/latency_record.hpp"
 #include "common/program.hpp"
 #include "common/shutdown.hpp"
 #include "vision/blob_tracker.hpp"
 #include "vision/calibration_file.hpp"
+#include "vision/frame_decoder.hpp"
 #include "vision/image_folder.hpp"
 #include "vision/image_message.hpp"
 #include "vision/stereo_pairer.hpp"
@@ -74,6 +76,10 @@ class StereoVision {
     bus_.publish("BLOB_RIGHT", out.blob[1]);
   }
 
+  cv::Rect next_window(size_t camera, cv::Size frame) const {
+    return step_.next_window(camera, frame);
+  }
+
   void report(uint64_t unmatched, uint64_t bad_images) const {
     const sg::vision::StereoCounts& c = step_.counts();
     auto pct = [&](uint64_t n) {
@@ -93,32 +99,66 @@ class StereoVision {
   bool publish_images_;
 };
 
-int run_lcm(sg::Bus& bus, StereoVision& vision, const Options& o) {
-  uint64_t bad = 0;
-  int64_t frames = 0;
-  sg::vision::StereoPairer<cv::Mat> pairer(std::llround(o.pair_tolerance_ms * 1000));
-  int64_t frame_number = 0;
-  auto on_image = [&](const image_t& m, const sg::ReceiveInfo& info) {
-    std::string error;
-    const auto image = sg::vision::decode_image(m, &error);
-    if (!image) {
-      if (++bad <= 10 || bad % 1000 == 0)
-        spdlog::warn("{}: dropped an image: {} ({} so far)", info.channel, error, bad);
-      return;
-    }
+/// Stereo pairs from CAMERA_LEFT and CAMERA_RIGHT: paired as messages, then each decoded where
+/// its tracker will look (frame_decoder.hpp); times each pair from the second image's arrival
+/// to OBJECT_POSITION published.
+class BusFrames {
+ public:
+  BusFrames(StereoVision& vision, const Options& o, sg::vision::FrameDecoder::Mode mode)
+      : vision_(vision),
+        pairer_(std::llround(o.pair_tolerance_ms * 1000)),
+        decoders_{sg::vision::FrameDecoder(mode), sg::vision::FrameDecoder(mode)} {}
+
+  void on_image(const image_t& m, const sg::ReceiveInfo& info) {
     const int side = info.channel == "CAMERA_LEFT" ? 0 : 1;
-    if (side == 0) frame_number = m.frame_number;
-    if (auto pair = pairer.add(side, m.utime, *image)) {
-      vision.process(pair->first, pair->second, frame_number, m.utime);
-      ++frames;
+    if (const std::string e = sg::vision::image_message_error(m); !e.empty()) return drop(info, e);
+    auto pair = pairer_.add(side, m.utime, m);
+    if (!pair) return;
+    const image_t* messages[2] = {&pair->first, &pair->second};
+    const cv::Mat* frames[2];
+    for (size_t i = 0; i < 2; ++i) {
+      std::string error;
+      const cv::Size size(messages[i]->width, messages[i]->height);
+      frames[i] = decoders_[i].decode(*messages[i], vision_.next_window(i, size), &error);
+      if (!frames[i]) return drop(info, error);
     }
-  };
+    vision_.process(*frames[0], *frames[1], pair->first.frame_number, pair->first.utime);
+    pair_to_position_.add(sg::now_utime() - info.recv_utime);
+    ++pairs_;
+  }
+
+  int64_t pairs() const { return pairs_; }
+  void report(uint64_t bus_errors) const {
+    vision_.report(pairer_.unmatched(), bad_ + bus_errors);
+    std::printf("second image received -> OBJECT_POSITION published: %s (decode: %s)\n",
+                pair_to_position_.summary().c_str(),
+                decoders_[0].mode() == sg::vision::FrameDecoder::Mode::kRegion ? "region" : "full");
+  }
+
+ private:
+  void drop(const sg::ReceiveInfo& info, const std::string& error) {
+    if (++bad_ <= 10 || bad_ % 1000 == 0)
+      spdlog::warn("{}: dropped an image: {} ({} so far)", info.channel, error, bad_);
+  }
+
+  StereoVision& vision_;
+  sg::vision::StereoPairer<image_t> pairer_;
+  sg::vision::FrameDecoder decoders_[2];
+  sg::LatencyRecord pair_to_position_;
+  uint64_t bad_ = 0;
+  int64_t pairs_ = 0;
+};
+
+int run_lcm(sg::Bus& bus, StereoVision& vision, const Options& o,
+            sg::vision::FrameDecoder::Mode mode) {
+  BusFrames frames(vision, o, mode);
+  auto on_image = [&](const image_t& m, const sg::ReceiveInfo& info) { frames.on_image(m, info); };
   bus.subscribe<image_t>("CAMERA_LEFT", on_image, sg::kQueueFrames);
   bus.subscribe<image_t>("CAMERA_RIGHT", on_image, sg::kQueueFrames);
   bus.announce("sg-vision");  // after subscribing: the first PROCESS_STATUS says it listens
   spdlog::info("waiting for CAMERA_LEFT and CAMERA_RIGHT");
-  bus.spin([&] { return o.max_frames == 0 || frames < o.max_frames; });
-  vision.report(pairer.unmatched(), bad + bus.decode_errors());
+  bus.spin([&] { return o.max_frames == 0 || frames.pairs() < o.max_frames; });
+  frames.report(bus.decode_errors());
   return 0;
 }
 
@@ -235,6 +275,8 @@ int main(int argc, char** argv) {
   CLI::App app{"Finds the red ball in both cameras and places it in 3D.", "sg-vision"};
   sg::CommonOptions common;
   sg::add_common_options(app, common);
+  const auto keys = sg::declared_keys(sg::vision::read_vision_settings);
+  common.flags.add(app, "--decode", "vision.decode", keys);
   Options o;
   app.add_option("--source", o.source, "lcm (CAMERA_LEFT/RIGHT), video, images or v4l2")
       ->check(CLI::IsMember({"lcm", "video", "images", "v4l2"}));
@@ -275,6 +317,8 @@ int main(int argc, char** argv) {
                               ? cv::Size(calibration->left.width(), calibration->left.height())
                               : cv::Size(o.width, o.height);
     StereoVision vision(bus, settings, size, calibration, o.publish_images);
-    return o.source == "lcm" ? run_lcm(bus, vision, o) : run_frames(vision, o);
+    const auto mode = settings.decode == "full" ? sg::vision::FrameDecoder::Mode::kFull
+                                                : sg::vision::FrameDecoder::Mode::kRegion;
+    return o.source == "lcm" ? run_lcm(bus, vision, o, mode) : run_frames(vision, o);
   });
 }

@@ -12,8 +12,8 @@ double square(double x) { return x * x; }
 /// The geometric part of a pair's cost; infinite when the point is behind a camera.
 double pair_geometry_cost(const Candidate& l, const Candidate& r, const StereoCalibration& cal,
                           const StereoMatchParams& p, Eigen::Vector3d& position) {
-  const Triangulated t = triangulate_linear(cal.left, {l.centre.x, l.centre.y}, cal.right,
-                                            {r.centre.x, r.centre.y});
+  const Triangulated t =
+      triangulate_linear(cal.left, {l.centre.x, l.centre.y}, cal.right, {r.centre.x, r.centre.y});
   if (t.behind_camera || !t.position.allFinite()) return std::numeric_limits<double>::infinity();
   position = t.position;
   double cost = square(t.reprojection_error / p.epipolar_sigma);

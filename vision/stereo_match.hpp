@@ -13,7 +13,8 @@
 /// with e the triangulation's RMS reprojection error.
 ///
 ///     const StereoMatch m = match_stereo(left_detection, right_detection, calibration, {});
-///     if (m.found()) { left.accept(left_detection, m.left); right.accept(right_detection, m.right); }
+///     if (m.found()) { left.accept(left_detection, m.left); right.accept(right_detection,
+///     m.right); }
 
 #include <Eigen/Core>
 #include <limits>

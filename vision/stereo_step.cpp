@@ -1,12 +1,11 @@
 #include "vision/stereo_step.hpp"
 
-#include "vision/sphere_image.hpp"
-
 #include <spdlog/spdlog.h>
 
 #include <cmath>
 
 #include "vision/image_message.hpp"
+#include "vision/sphere_image.hpp"
 #include "vision/triangulation.hpp"
 
 namespace sg::vision {
@@ -14,8 +13,7 @@ namespace sg::vision {
 using stereograsp::point3_t;
 
 StereoStep::StereoStep(const BlobTracker::Params& params, cv::Size size,
-                       std::optional<StereoCalibration> calibration,
-                       const StereoMatchParams& match)
+                       std::optional<StereoCalibration> calibration, const StereoMatchParams& match)
     : trackers_{BlobTracker(params, size), BlobTracker(params, size)},
       size_(size),
       calibration_(std::move(calibration)),
@@ -37,6 +35,12 @@ std::optional<double> StereoStep::expected_radius(size_t camera) const {
   const double r = apparent_radius(camera == 0 ? calibration_->left : calibration_->right,
                                    *last_position_, match_.ball_radius);
   return std::isfinite(r) ? std::optional<double>(r) : std::nullopt;
+}
+
+cv::Rect StereoStep::next_window(size_t camera, cv::Size frame,
+                                 const std::optional<cv::Point2d>& predicted) const {
+  if (frame != size_) return {0, 0, frame.width, frame.height};
+  return trackers_[camera].next_window(predicted);
 }
 
 std::array<int, 2> StereoStep::choose(const std::array<Detection, 2>& d) const {

@@ -30,8 +30,8 @@ namespace sg::vision {
 
 /// One stereo pair's result.
 struct StereoOutput {
-  std::array<Observation, 2> observation;      ///< left, right
-  std::array<stereograsp::blob_t, 2> blob;     ///< BLOB_LEFT, BLOB_RIGHT
+  std::array<Observation, 2> observation;         ///< left, right
+  std::array<stereograsp::blob_t, 2> blob;        ///< BLOB_LEFT, BLOB_RIGHT
   std::optional<stereograsp::point3_t> position;  ///< OBJECT_POSITION, with a calibration
 };
 
@@ -59,6 +59,12 @@ class StereoStep {
                        int64_t utime,
                        const std::array<std::optional<cv::Point2d>, 2>& predicted = {});
 
+  /// The pixels of a `frame`-sized image from `camera` (0 left, 1 right) that the next process()
+  /// reads (BlobTracker::next_window; all of it when the size differs and tracking restarts):
+  /// a caller may decode only these (frame_decoder.hpp).
+  cv::Rect next_window(size_t camera, cv::Size frame,
+                       const std::optional<cv::Point2d>& predicted = std::nullopt) const;
+
   const StereoCounts& counts() const { return counts_; }
   const std::optional<StereoCalibration>& calibration() const { return calibration_; }
 
@@ -77,8 +83,9 @@ class StereoStep {
 };
 
 /// OBJECT_POSITION from both cameras' observations: visible only when both found the ball
-/// (seen_by says which did); then the triangulated centre of the ball's images (Observation::centre) (eq. 26, refined), its per-axis sigma,
-/// the reprojection error and the geometry flags; otherwise NaN position and sigma.
+/// (seen_by says which did); then the triangulated centre of the ball's images
+/// (Observation::centre) (eq. 26, refined), its per-axis sigma, the reprojection error and the
+/// geometry flags; otherwise NaN position and sigma.
 stereograsp::point3_t position_of(const std::array<Observation, 2>& o,
                                   const StereoCalibration& calibration, int64_t utime);
 

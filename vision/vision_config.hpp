@@ -13,6 +13,9 @@ struct VisionSettings {
   BlobTracker::Params tracker;
   StereoMatchParams match;  ///< the ball's radius and the stereo pairing
   std::string calibration;  ///< a stereo calibration file; with it OBJECT_POSITION is published
+  /// JPEGs from the bus: "region" decodes only the search windows while tracking
+  /// (frame_decoder.hpp), "full" every frame whole (the baseline).
+  std::string decode = "region";
 };
 
 /// Reads the `vision` section: every key range-checked, any other key of the section refused

@@ -120,8 +120,7 @@ TEST(JpegRegionDecoder, RegionIsBitIdenticalToTheWholeDecode) {
 TEST(JpegRegionDecoder, WholeDecodeIsOpenCvs) {
   for (const Jpeg& j : jpegs()) {
     SCOPED_TRACE(j.name);
-    const cv::Mat theirs =
-        cv::imdecode(j.bytes, cv::IMREAD_COLOR | cv::IMREAD_IGNORE_ORIENTATION);
+    const cv::Mat theirs = cv::imdecode(j.bytes, cv::IMREAD_COLOR | cv::IMREAD_IGNORE_ORIENTATION);
     EXPECT_EQ(cv::norm(whole(j), theirs, cv::NORM_INF), 0.0);
   }
 }
