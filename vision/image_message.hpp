@@ -9,7 +9,8 @@
 
 namespace sg::vision {
 
-/// An image_t from a BGR frame: JPEG (quality 1-100) or raw BGR8.
+/// An image_t from a BGR frame: JPEG (quality 1-100, 4:2:0, restart markers every 4 MCUs of each
+/// row, so that sg-vision can decode a window's segments alone: jpeg_band.hpp) or raw BGR8.
 stereograsp::image_t encode_image(const cv::Mat& bgr, int8_t camera, int64_t frame_number,
                                   int64_t utime, bool jpeg, int jpeg_quality = 90);
 

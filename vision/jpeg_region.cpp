@@ -7,6 +7,9 @@
 
 #include <algorithm>
 #include <csetjmp>
+#include <vector>
+
+#include "vision/jpeg_band.hpp"
 
 namespace sg::vision {
 namespace {
@@ -40,6 +43,11 @@ void on_progress(j_common_ptr cinfo) {
   }
 }
 
+/// Pixels around a region that a part cut at restart markers also covers: the upsampling of a
+/// subsampled chroma reads one chroma sample (2 px) beyond a pixel, and a part's own edge is
+/// upsampled from replicated samples. Twice that reach (a test checks the pixels bit for bit).
+constexpr int kCutMargin = 4;
+
 /// `region` clipped to the image and widened by `mx`, `my` px on each side (empty: all of it).
 cv::Rect widened(cv::Rect region, cv::Size size, int mx, int my) {
   const cv::Rect all(0, 0, size.width, size.height);
@@ -57,6 +65,9 @@ struct JpegRegionDecoder::State {
   jpeg_decompress_struct cinfo{};
   ErrorManager error{};
   jpeg_progress_mgr progress{};
+  JpegLayout layout;          // of the last JPEG, its vector reused
+  std::vector<uint8_t> part;  // the last part cut, reused
+  uint64_t parts = 0;
 };
 
 JpegRegionDecoder::JpegRegionDecoder() : state_(std::make_unique<State>()) {
@@ -73,14 +84,41 @@ JpegRegionDecoder::~JpegRegionDecoder() { jpeg_destroy_decompress(&state_->cinfo
 
 uint64_t JpegRegionDecoder::warnings() const { return state_->error.warnings; }
 
+namespace {
+
+std::string declared_error(int width, int height, cv::Size size) {
+  return "JPEG header declares " + std::to_string(width) + "x" + std::to_string(height) +
+         ", the message " + std::to_string(size.width) + "x" + std::to_string(size.height);
+}
+
+}  // namespace
+
 JpegRegionDecoder::Result JpegRegionDecoder::decode(const uint8_t* data, size_t bytes,
                                                     cv::Size size, cv::Rect region, cv::Mat& bgr) {
-  Result r;
-  if (data == nullptr || bytes == 0) {
-    r.error = "empty JPEG";
-    return r;
-  }
+  if (data == nullptr || bytes == 0) return {false, {}, "empty JPEG"};
   if (bgr.type() != CV_8UC3 || bgr.size() != size) bgr.create(size, CV_8UC3);
+  JpegLayout& layout = state_->layout;
+  const cv::Rect all(0, 0, size.width, size.height);
+  if (!(region & all).empty() && read_layout(data, bytes, layout) && layout.cuttable()) {
+    if (layout.width != size.width || layout.height != size.height)
+      return {false, {}, declared_error(layout.width, layout.height, size)};
+    const cv::Rect want = widened(region, size, kCutMargin, kCutMargin);
+    if (want != all) {  // only the part's own restart segments are decoded at all
+      const JpegCut cut =
+          cut_part(data, layout, want.x, want.y, want.br().x, want.br().y, state_->part);
+      ++state_->parts;
+      const cv::Point origin(cut.x, cut.y);
+      return decode_rows(state_->part.data(), state_->part.size(), {cut.width, cut.height},
+                         region - origin, bgr, origin);
+    }
+  }
+  return decode_rows(data, bytes, size, region, bgr, {0, 0});
+}
+
+JpegRegionDecoder::Result JpegRegionDecoder::decode_rows(const uint8_t* data, size_t bytes,
+                                                         cv::Size size, cv::Rect region,
+                                                         cv::Mat& bgr, cv::Point origin) {
+  Result r;
   jpeg_decompress_struct& c = state_->cinfo;
   // Only plain data lives across the setjmp: nothing with a destructor is skipped by longjmp.
   if (setjmp(state_->error.jump)) {
@@ -92,9 +130,8 @@ JpegRegionDecoder::Result JpegRegionDecoder::decode(const uint8_t* data, size_t 
   jpeg_read_header(&c, TRUE);
   if (static_cast<int>(c.image_width) != size.width ||
       static_cast<int>(c.image_height) != size.height) {
-    r.error = "JPEG header declares " + std::to_string(c.image_width) + "x" +
-              std::to_string(c.image_height) + ", the message " + std::to_string(size.width) + "x" +
-              std::to_string(size.height);
+    r.error =
+        declared_error(static_cast<int>(c.image_width), static_cast<int>(c.image_height), size);
     jpeg_abort_decompress(&c);
     return r;
   }
@@ -107,8 +144,9 @@ JpegRegionDecoder::Result JpegRegionDecoder::decode(const uint8_t* data, size_t 
   if (want.width < size.width) jpeg_crop_scanline(&c, &x, &width);  // x moves left to an iMCU
   if (want.y > 0) jpeg_skip_scanlines(&c, static_cast<JDIMENSION>(want.y));
   while (static_cast<int>(c.output_scanline) < want.br().y) {
-    JSAMPROW row = bgr.ptr<uint8_t>(static_cast<int>(c.output_scanline)) + 3 * x;
-    if (jpeg_read_scanlines(&c, &row, 1) != 1) {  // cannot happen with a memory source
+    JSAMPROW out = bgr.ptr<uint8_t>(origin.y + static_cast<int>(c.output_scanline)) +
+                   3 * (origin.x + static_cast<int>(x));
+    if (jpeg_read_scanlines(&c, &out, 1) != 1) {  // cannot happen with a memory source
       jpeg_abort_decompress(&c);
       r.error = "JPEG decoder gave no scanline";
       return r;
@@ -119,8 +157,11 @@ JpegRegionDecoder::Result JpegRegionDecoder::decode(const uint8_t* data, size_t 
   else
     jpeg_abort_decompress(&c);
   r.ok = true;
-  r.decoded = cv::Rect(static_cast<int>(x), want.y, static_cast<int>(width), want.height);
+  r.decoded = cv::Rect(origin.x + static_cast<int>(x), origin.y + want.y, static_cast<int>(width),
+                       want.height);
   return r;
 }
+
+uint64_t JpegRegionDecoder::parts() const { return state_->parts; }
 
 }  // namespace sg::vision

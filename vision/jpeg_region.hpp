@@ -6,7 +6,9 @@
 /// (`jpeg_skip_scanlines` to its first row, `jpeg_read_scanlines` through its last) and, within
 /// it, only the iMCU columns that cover the window (`jpeg_crop_scanline`, which widens the
 /// request to iMCU boundaries, 8 or 16 px). The DCT blocks above the band are still entropy-
-/// decoded (a baseline JPEG has no index), but not transformed, upsampled or colour-converted.
+/// decoded (a baseline JPEG has no index), but not transformed, upsampled or colour-converted —
+/// unless the JPEG has restart markers at MCU-row boundaries: then only the restart segments
+/// around the region are decoded at all (jpeg_band.hpp), as in sg-camera-sim's frames.
 ///
 ///     JpegRegionDecoder decoder;
 ///     cv::Mat frame;                                        // kept from frame to frame
@@ -56,8 +58,13 @@ class JpegRegionDecoder {
 
   /// Warnings libjpeg-turbo gave over all decodes (corrupt data it decoded through).
   uint64_t warnings() const;
+  /// Decodes that cut a part out at restart markers (jpeg_band.hpp) instead of skipping rows.
+  uint64_t parts() const;
 
  private:
+  Result decode_rows(const uint8_t* data, size_t bytes, cv::Size size, cv::Rect region,
+                     cv::Mat& bgr, cv::Point origin);
+
   struct State;
   std::unique_ptr<State> state_;
 };

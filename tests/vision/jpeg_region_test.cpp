@@ -59,6 +59,13 @@ const std::vector<Jpeg>& jpegs() {
         {"frame (4:2:0, q 90)", encode(frame, {cv::IMWRITE_JPEG_QUALITY, 90}), {}},
         {"frame (progressive)", encode(frame, {cv::IMWRITE_JPEG_PROGRESSIVE, 1}), {}},
         {"frame (greyscale)", encode(grey, {}), {}},
+        // restart markers: every MCU row, every second row, in rows of 8 px (greyscale), ten a
+        // row, and every 3 MCUs (not at row boundaries: rows are skipped instead of cut)
+        {"frame (RST every row)", encode(frame, {cv::IMWRITE_JPEG_RST_INTERVAL, 40}), {}},
+        {"frame (RST every 2 rows)", encode(frame, {cv::IMWRITE_JPEG_RST_INTERVAL, 80}), {}},
+        {"frame (greyscale, RST every row)", encode(grey, {cv::IMWRITE_JPEG_RST_INTERVAL, 80}), {}},
+        {"frame (RST every 4 MCUs)", encode(frame, {cv::IMWRITE_JPEG_RST_INTERVAL, 4}), {}},
+        {"frame (RST every 3 MCUs)", encode(frame, {cv::IMWRITE_JPEG_RST_INTERVAL, 3}), {}},
     };
     for (Jpeg& j : v) {
       const cv::Mat m = cv::imdecode(j.bytes, cv::IMREAD_UNCHANGED);
@@ -114,6 +121,41 @@ TEST(JpegRegionDecoder, RegionIsBitIdenticalToTheWholeDecode) {
       EXPECT_EQ(cv::norm(bgr(region), all(region), cv::NORM_INF), 0.0);
     }
   }
+}
+
+// A JPEG with restart markers at MCU-row boundaries is cut (jpeg_band.hpp) for every region short
+// of the whole image; any other is decoded by skipping rows.
+TEST(JpegRegionDecoder, PartsAreCutWhereRestartsAreAtRowBoundaries) {
+  for (const Jpeg& j : jpegs()) {
+    SCOPED_TRACE(j.name);
+    JpegRegionDecoder decoder;
+    cv::Mat bgr;
+    for (const cv::Rect& asked : regions(j.size)) {
+      ASSERT_TRUE(decoder.decode(j.bytes.data(), j.bytes.size(), j.size, asked, bgr).ok);
+    }
+    const bool row_restarts =
+        j.name.find("RST every") != std::string::npos && j.name.find("3 MCUs") == std::string::npos;
+    if (row_restarts)
+      EXPECT_GE(decoder.parts(), regions(j.size).size() - 3);  // all but the full-height ones
+    else
+      EXPECT_EQ(decoder.parts(), 0u);
+  }
+}
+
+// A JPEG whose restart markers do not count RST0, RST1, ... (a corrupt or crafted one) is not cut
+// but decoded by libjpeg-turbo as it is, which warns of the markers and goes on.
+TEST(JpegRegionDecoder, MisnumberedRestartsAreNotCut) {
+  std::vector<uint8_t> bytes = jpegs()[5].bytes;  // RST every row
+  size_t changed = 0;
+  for (size_t i = 0; i + 1 < bytes.size() && changed == 0; ++i)
+    if (bytes[i] == 0xFF && bytes[i + 1] == 0xD3) bytes[i + 1] = 0xD5, ++changed;
+  ASSERT_EQ(changed, 1u);
+  JpegRegionDecoder decoder;
+  cv::Mat bgr;
+  const auto r = decoder.decode(bytes.data(), bytes.size(), {640, 480}, {300, 200, 40, 40}, bgr);
+  EXPECT_TRUE(r.ok) << r.error;
+  EXPECT_EQ(decoder.parts(), 0u);
+  EXPECT_GT(decoder.warnings(), 0u);
 }
 
 // The whole decode is OpenCV's imdecode, pixel for pixel (a greyscale JPEG as BGR).
