@@ -61,4 +61,29 @@ ColorThresholds ColorThresholds::learn(const cv::Mat& bgr, const cv::Rect& roi, 
   return t;
 }
 
+namespace {
+
+/// The row kernel, one clone per instruction set; the loader picks the best the CPU has.
+__attribute__((target_clones("avx2", "default"))) void classify_row(
+    const uint8_t* __restrict bgr, int n, uint8_t* __restrict mask, int32_t r_lo, int32_t r_hi,
+    int32_t g_lo, int32_t g_hi, int32_t b_lo, int32_t b_hi, int32_t min_sum) {
+  constexpr int32_t kOne = 1 << 16;
+  for (int i = 0; i < n; ++i) {
+    const int32_t b = bgr[3 * i], g = bgr[3 * i + 1], r = bgr[3 * i + 2];
+    const int32_t sum = b + g + r;
+    mask[i] = static_cast<uint8_t>((sum >= min_sum) & (r * kOne >= r_lo * sum) &
+                                   (g * kOne <= g_hi * sum) & (b * kOne <= b_hi * sum) &
+                                   (r * kOne <= r_hi * sum) & (g * kOne >= g_lo * sum) &
+                                   (b * kOne >= b_lo * sum));
+  }
+}
+
+}  // namespace
+
+void ColorDetector::classify(const uint8_t* bgr, int n, uint8_t* mask) const {
+  auto c = [](int64_t v) { return static_cast<int32_t>(v); };  // all in [0, 65536]
+  classify_row(bgr, n, mask, c(r_lo_), c(r_hi_), c(g_lo_), c(g_hi_), c(b_lo_), c(b_hi_),
+               c(min_sum_));
+}
+
 }  // namespace sg::vision

@@ -1,15 +1,25 @@
 #include "vision/segmentation.hpp"
 
+#include <bit>
+#include <cstring>
 #include <stdexcept>
 
 namespace sg::vision {
 
-Segmenter::Segmenter(cv::Size max_size) {
+Segmenter::Segmenter(cv::Size max_size, Kernel kernel) : max_size_(max_size), kernel_(kernel) {
   const size_t pixels = static_cast<size_t>(max_size.area());
-  labels_.resize(pixels);
-  parent_.resize(pixels / 2 + 2);  // 8-connectivity: at most one new label every other pixel
-  sums_.resize(pixels / 2 + 2);
+  const size_t rows = static_cast<size_t>(max_size.height);
+  // 8-connectivity: at most one new label (one run) every other pixel, half a pixel more a row
+  const size_t labels = pixels / 2 + rows + 2;
+  if (kernel_ == Kernel::kPixels) labels_.resize(pixels);
+  parent_.resize(labels);
+  sums_.resize(labels);
   mask_.resize(static_cast<size_t>((max_size.width + 2) * (max_size.height + 2)));
+  if (kernel_ == Kernel::kRuns) {
+    runs_.resize(labels);
+    row_start_.resize(rows + 1);
+    row_mask_.resize(static_cast<size_t>(max_size.width) + 8);
+  }
 }
 
 int32_t Segmenter::find(int32_t label) {
@@ -85,6 +95,78 @@ void Segmenter::label_window(const cv::Mat& bgr, const ColorDetector& detector) 
   }
 }
 
+namespace {
+
+/// The first x in [x, n) where the mask is `set` (n when none), eight bytes at a time.
+int next_where(const uint8_t* mask, int x, int n, bool set) {
+  static_assert(std::endian::native == std::endian::little, "the byte order ctz reads");
+  const uint64_t flip = set ? 0 : 0x0101010101010101ull;
+  for (; x + 8 <= n; x += 8) {
+    uint64_t v;
+    std::memcpy(&v, mask + x, 8);
+    if ((v ^= flip) != 0) return x + __builtin_ctzll(v) / 8;
+  }
+  while (x < n && (mask[x] != 0) != set) ++x;
+  return x;
+}
+
+/// Sum of k^2 for k in [0, x].
+int64_t squares_to(int64_t x) { return x * (x + 1) * (2 * x + 1) / 6; }
+
+/// A run's pixels [xa, xb] of image row y: moments in closed form, extent, colour.
+void add_run(Region& r, int64_t xa, int64_t xb, int64_t y, const uint8_t* bgr) {
+  const int64_t n = xb - xa + 1, sum_x = (xa + xb) * n / 2;
+  RawMoments& m = r.moments;
+  m.m00 += n, m.m10 += sum_x, m.m01 += n * y;
+  m.m20 += squares_to(xb) - squares_to(xa - 1), m.m02 += n * y * y, m.m11 += y * sum_x;
+  r.x_min = std::min(r.x_min, static_cast<int>(xa)),
+  r.x_max = std::max(r.x_max, static_cast<int>(xb));
+  r.y_max = static_cast<int>(y);
+  for (int64_t i = 0; i < n; ++i, bgr += 3) r.sum_b += bgr[0], r.sum_g += bgr[1], r.sum_r += bgr[2];
+}
+
+}  // namespace
+
+// The label of a run [x0, x1) joining the runs above it that touch it (8-connected: an above run
+// [a, b) touches when a <= x1 and b >= x0); `above` moves past the runs that end too far left.
+int32_t Segmenter::label_of_run(int x0, int x1, size_t& above, size_t above_end) {
+  while (above < above_end && runs_[above].x1 < x0) ++above;
+  int32_t label = 0;
+  for (size_t q = above; q < above_end && runs_[q].x0 <= x1; ++q)
+    label = label == 0 ? runs_[q].label : unite(label, runs_[q].label);
+  return label;
+}
+
+// Row by row: classify, find the runs, label them against the row above, sum them.
+void Segmenter::label_runs(const cv::Mat& bgr, const ColorDetector& detector) {
+  const cv::Rect& w = window_;
+  next_ = 1;
+  parent_[0] = 0;
+  size_t count = 0;
+  for (int y = 0; y < w.height; ++y) {
+    const uint8_t* in = bgr.ptr<uint8_t>(w.y + y) + 3 * w.x;
+    detector.classify(in, w.width, row_mask_.data());
+    size_t above = y > 0 ? row_start_[static_cast<size_t>(y - 1)] : 0;
+    const size_t above_end = count;
+    row_start_[static_cast<size_t>(y)] = count;
+    for (int x0 = next_where(row_mask_.data(), 0, w.width, true); x0 < w.width;
+         x0 = next_where(row_mask_.data(), x0, w.width, true)) {
+      const int x1 = next_where(row_mask_.data(), x0, w.width, false);
+      int32_t label = y > 0 ? label_of_run(x0, x1, above, above_end) : 0;
+      if (label == 0) {
+        label = next_++;
+        parent_[static_cast<size_t>(label)] = label;
+        sums_[static_cast<size_t>(label)] =
+            Region{{}, w.x + x0, w.y + y, w.x + x0, w.y + y, 0, 0, 0, label};
+      }
+      runs_[count++] = {x0, x1, label};
+      add_run(sums_[static_cast<size_t>(label)], w.x + x0, w.x + x1 - 1, w.y + y, in + 3 * x0);
+      x0 = x1;
+    }
+  }
+  row_start_[static_cast<size_t>(w.height)] = count;
+}
+
 // A label's parent is never larger than itself, so one forward pass points each at its root;
 // each provisional label's sums then go to its root.
 void Segmenter::sum_regions() {
@@ -112,9 +194,12 @@ Segmentation Segmenter::run(const cv::Mat& bgr, const cv::Rect& window,
                             const ColorDetector& detector, int min_area) {
   CV_Assert(bgr.type() == CV_8UC3);
   window_ = window & cv::Rect(0, 0, bgr.cols, bgr.rows);
-  if (static_cast<size_t>(window_.area()) > labels_.size())
+  if (window_.width > max_size_.width || window_.height > max_size_.height)
     throw std::invalid_argument("Segmenter: window larger than the size it was made for");
-  label_window(bgr, detector);
+  if (kernel_ == Kernel::kRuns)
+    label_runs(bgr, detector);
+  else
+    label_window(bgr, detector);
   sum_regions();
   Segmentation result;
   for (int32_t i = 1; i < next_; ++i) {
@@ -137,6 +222,10 @@ cv::Mat Segmenter::mask_of(const Region& region) {
   mask_origin_ = box.tl();
   cv::Mat mask(box.height, box.width, CV_8UC1, mask_.data());
   if (box.empty()) return mask;
+  if (kernel_ == Kernel::kRuns) {
+    paint_runs(region, box, mask);
+    return mask;
+  }
   for (int y = 0; y < box.height; ++y) {
     const int32_t* row = labels_.data() +
                          static_cast<size_t>(box.y - window_.y + y) * window_.width +
@@ -147,6 +236,21 @@ cv::Mat Segmenter::mask_of(const Region& region) {
     }
   }
   return mask;
+}
+
+// The region's runs (after sum_regions(), every run's label points at its root) into `mask`.
+void Segmenter::paint_runs(const Region& region, const cv::Rect& box, cv::Mat& mask) const {
+  mask.setTo(0);
+  for (int y = 0; y < box.height; ++y) {
+    const size_t row = static_cast<size_t>(box.y - window_.y + y);
+    uint8_t* out = mask.ptr<uint8_t>(y);
+    for (size_t k = row_start_[row]; k < row_start_[row + 1]; ++k) {
+      const Run& r = runs_[k];
+      if (parent_[static_cast<size_t>(r.label)] != region.label) continue;
+      const int a = std::max(r.x0 + window_.x, box.x), b = std::min(r.x1 + window_.x, box.br().x);
+      if (a < b) std::memset(out + (a - box.x), 255, static_cast<size_t>(b - a));
+    }
+  }
 }
 
 }  // namespace sg::vision
