@@ -1,0 +1,130 @@
+// The vectorized kernels give the reference's results bit for bit (issue 19): ColorDetector::
+// classify against is_object() over every 8-bit colour, and Segmenter's run labelling against
+// its pixel labelling on opencv-doc's photographs, the simulated lab and noise, window by window:
+// the same regions, in the same order, with the same moments, extent, colour and masks.
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "sim/camera_simulator.hpp"
+#include "sim/real_scene.hpp"
+#include "vision/color_detector.hpp"
+#include "vision/segmentation.hpp"
+
+namespace sg::vision {
+namespace {
+
+/// Threshold sets: the shipped red, the widest, an upper bound of 1 and one of 0, a narrow one.
+std::vector<ColorThresholds> threshold_sets() {
+  std::vector<ColorThresholds> v(5);
+  v[1] = {0, 1, 0, 1, 0, 1, 0};
+  v[2] = {0.2, 1.0, 0.0, 1.0, 0.1, 0.5, 1};
+  v[3] = {0.0, 0.0, 0.3, 0.7, 0.3, 0.7, 765};
+  v[4] = {0.5123, 0.5189, 0.2, 0.25, 0.2, 0.3, 30};
+  return v;
+}
+
+// Every one of the 2^24 colours: classify() says what is_object() says.
+TEST(ColorKernels, ClassifyIsIsObjectForEveryColour) {
+  std::vector<uint8_t> bgr(size_t{3} << 24), mask(size_t{1} << 24);
+  for (size_t i = 0; i < mask.size(); ++i) {
+    bgr[3 * i] = static_cast<uint8_t>(i), bgr[3 * i + 1] = static_cast<uint8_t>(i >> 8);
+    bgr[3 * i + 2] = static_cast<uint8_t>(i >> 16);
+  }
+  for (const ColorThresholds& t : threshold_sets()) {
+    const ColorDetector d(t);
+    d.classify(bgr.data(), static_cast<int>(mask.size()), mask.data());
+    size_t wrong = 0, objects = 0;
+    for (size_t i = 0; i < mask.size(); ++i) {
+      const bool is = d.is_object(&bgr[3 * i]);
+      objects += is;
+      wrong += mask[i] != (is ? 1 : 0);
+    }
+    EXPECT_EQ(wrong, 0u) << "r " << t.r_min << "-" << t.r_max << ", " << objects << " objects";
+  }
+}
+
+void expect_same(const Segmentation& a, const Segmentation& b) {
+  EXPECT_EQ(a.num_regions, b.num_regions);
+  EXPECT_EQ(a.found, b.found);
+  EXPECT_EQ(a.num_candidates, b.num_candidates);
+  auto same_moments = [](const RawMoments& x, const RawMoments& y) {
+    return x.m00 == y.m00 && x.m10 == y.m10 && x.m01 == y.m01 && x.m20 == y.m20 && x.m02 == y.m02 &&
+           x.m11 == y.m11;
+  };
+  EXPECT_TRUE(same_moments(a.largest, b.largest));
+  for (int k = 0; k < std::min(a.num_candidates, b.num_candidates); ++k) {
+    const Region &x = a.regions[static_cast<size_t>(k)], &y = b.regions[static_cast<size_t>(k)];
+    EXPECT_TRUE(same_moments(x.moments, y.moments)) << "candidate " << k;
+    EXPECT_EQ(x.box(), y.box()) << "candidate " << k;
+    EXPECT_EQ(x.sum_b, y.sum_b);
+    EXPECT_EQ(x.sum_g, y.sum_g);
+    EXPECT_EQ(x.sum_r, y.sum_r);
+  }
+}
+
+/// Both kernels on `windows` of `image` with every threshold set: the same regions and masks.
+/// Returns the regions seen (so a test knows it segmented something).
+int compare_kernels(const cv::Mat& image, const std::vector<cv::Rect>& windows) {
+  Segmenter runs(image.size(), Segmenter::Kernel::kRuns);
+  Segmenter pixels(image.size(), Segmenter::Kernel::kPixels);
+  int regions = 0;
+  for (const ColorThresholds& t : threshold_sets()) {
+    const ColorDetector d(t);
+    for (const cv::Rect& w : windows) {
+      SCOPED_TRACE(testing::Message() << "window " << w << ", r_min " << t.r_min);
+      const Segmentation a = runs.run(image, w, d, 5), b = pixels.run(image, w, d, 5);
+      expect_same(a, b);
+      regions += a.num_regions;
+      for (int k = 0; k < std::min(a.num_candidates, 3); ++k) {
+        const cv::Mat ma = runs.mask_of(a.regions[static_cast<size_t>(k)]).clone();
+        const cv::Mat mb = pixels.mask_of(b.regions[static_cast<size_t>(k)]);
+        EXPECT_EQ(ma.size(), mb.size());
+        if (ma.size() == mb.size()) {
+          EXPECT_EQ(cv::countNonZero(ma != mb), 0) << "mask of candidate " << k;
+        }
+        EXPECT_EQ(runs.mask_origin(), pixels.mask_origin());
+      }
+    }
+  }
+  return regions;
+}
+
+std::vector<cv::Rect> windows_of(cv::Size s) {
+  std::vector<cv::Rect> v = {{0, 0, s.width, s.height}, {1, 1, 7, 5}, {s.width - 33, 0, 33, 17}};
+  std::mt19937 rng(2);
+  for (int k = 0; k < 12; ++k) {
+    const int w = 1 + static_cast<int>(rng() % 200), h = 1 + static_cast<int>(rng() % 200);
+    v.push_back({static_cast<int>(rng() % static_cast<unsigned>(s.width)),
+                 static_cast<int>(rng() % static_cast<unsigned>(s.height)), w, h});
+  }
+  return v;
+}
+
+// Real photographs (opencv-doc): fruits (red apples), baboon (red nose), a board, a building.
+TEST(SegmentationKernels, RunsArePixelsOnPhotographs) {
+  for (const std::string name : {"fruits.jpg", "baboon.jpg", "board.jpg", "building.jpg"}) {
+    SCOPED_TRACE(name);
+    const cv::Mat image = cv::imread(sim::opencv_data_dir() + "/" + name, cv::IMREAD_COLOR);
+    ASSERT_FALSE(image.empty());
+    EXPECT_GT(compare_kernels(image, windows_of(image.size())), 50);
+  }
+}
+
+// The simulated lab's frames, and noise (thousands of small regions, every run shape).
+TEST(SegmentationKernels, RunsArePixelsOnTheSimulatorAndNoise) {
+  sim::CameraSimulator sim({});
+  sim::StereoFrame f;
+  sim.render(30, {}, f);
+  EXPECT_GT(compare_kernels(f.image[0], windows_of(f.image[0].size())), 10);
+  cv::Mat noise(240, 320, CV_8UC3);
+  cv::randu(noise, 0, 255);
+  EXPECT_GT(compare_kernels(noise, windows_of(noise.size())), 1000);
+}
+
+}  // namespace
+}  // namespace sg::vision
