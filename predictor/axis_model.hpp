@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -45,5 +46,25 @@ std::unique_ptr<AxisModel> make_kalman_axis(const KalmanParams& params);
 
 /// Holds the last value.
 std::unique_ptr<AxisModel> make_hold_axis();
+
+/// The three axes' models of a trajectory (x, y, z) as one: what TrajectoryPredictor feeds.
+class TrajectoryModel {
+ public:
+  virtual ~TrajectoryModel() = default;
+  /// AxisModel::push of each axis.
+  virtual void push(const std::array<double, 3>& value, bool measured) = 0;
+  /// AxisModel::forecast of each axis.
+  virtual std::array<std::vector<double>, 3> forecast(int horizon) const = 0;
+  /// AxisModel::replace_newest of each axis.
+  virtual void replace_newest(const std::array<std::vector<double>, 3>& values) = 0;
+};
+
+/// Three Burg axes (params[i]: axis i's, their initial coefficients may differ) whose
+/// coefficients are estimated together, in one pass over the three windows (burg3, issue 19):
+/// the same forecasts as three make_burg_axis() bit for bit, in about the time of one.
+std::unique_ptr<TrajectoryModel> make_burg_trajectory(const std::array<BurgParams, 3>& params);
+/// Three axis models side by side (the Kalman and hold baselines).
+std::unique_ptr<TrajectoryModel> make_axes_trajectory(
+    std::array<std::unique_ptr<AxisModel>, 3> axes);
 
 }  // namespace sg::predictor

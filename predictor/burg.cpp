@@ -1,21 +1,29 @@
 #include "predictor/burg.hpp"
 
+#include <cstdint>
 #include <stdexcept>
+#include <type_traits>
 
 namespace sg::predictor {
 namespace {
 
+/// Four doubles in one register (AVX2): the x, y and z axes and a spare lane of zeros.
+using Lanes = double __attribute__((vector_size(32)));
+
 /// The two sums of eq. 30 for the next stage: numerator sum e_f(n) e_b(n-1) and denominator
-/// sum e_f(n)^2 + e_b(n-1)^2 (without eq. 30's factor -2).
+/// sum e_f(n)^2 + e_b(n-1)^2 (without eq. 30's factor -2). V: one axis (double) or three (Lanes),
+/// the same operations in the same order, so each lane is bit for bit the one-axis result.
+template <class V>
 struct StageSums {
-  double num = 0;
-  double den = 0;
+  V num{};
+  V den{};
 };
 
 /// Stage 1's sums of eq. 30 over n = 1 .. N-1, with e_0^f = e_0^b = x (eq. 33, 34; burg.md's
 /// "start").
-StageSums first_stage_sums(const double* f, const double* b, int n) {
-  StageSums s;
+template <class V>
+[[gnu::always_inline]] inline StageSums<V> first_stage_sums(const V* f, const V* b, int n) {
+  StageSums<V> s;
   for (int i = 1; i < n; ++i) {
     s.num += f[i] * b[i - 1];
     s.den += f[i] * f[i] + b[i - 1] * b[i - 1];
@@ -25,9 +33,9 @@ StageSums first_stage_sums(const double* f, const double* b, int n) {
 
 /// eq. 30: r_k = -2 num / den; 0 when den is below 1e-12 of twice the signal's energy: nothing
 /// is left to model (burg.md, traps: a constant signal would give 0/0).
-double reflection(const StageSums& s, double energy) {
+double reflection(double num, double den, double energy) {
   double r = 0;
-  if (s.den > 1e-12 * 2 * energy && s.den > 0) r = -2 * s.num / s.den;  // else: nothing to model
+  if (den > 1e-12 * 2 * energy && den > 0) r = -2 * num / den;  // else: nothing to model
   return r;
 }
 
@@ -45,20 +53,21 @@ void update_coefficients(std::vector<double>& a, double r, int k) {
 /// e_b'(n) = e_b(n-1) + r e_f(n), for n = N-1 down to k (b[n-1] is still the previous stage's
 /// when b[n] is written), and stage k+1's sums of eq. 30 in the same pass: f[n+1] b[n] once b[n]
 /// is new. Returns those sums.
-StageSums next_stage(double* f, double* b, int n, int k, double r) {
-  StageSums s;
+template <class V>
+[[gnu::always_inline]] inline StageSums<V> next_stage(V* f, V* b, int n, int k, V r) {
+  StageSums<V> s;
   {
-    const double fi = f[n - 1], bi = b[n - 2];  // the top: no f[i+1] yet
+    const V fi = f[n - 1], bi = b[n - 2];  // the top: no f[i+1] yet
     f[n - 1] = fi + r * bi;
     b[n - 1] = bi + r * fi;
   }
   // Two partial sums each, so consecutive additions do not wait on each other.
-  double num2 = 0, den2 = 0;
+  V num2{}, den2{};
   int i = n - 2;
   for (; i - 1 >= k; i -= 2) {
-    const double f0 = f[i], b0 = b[i - 1], f1 = f[i - 1], b1 = b[i - 2];
-    const double f0n = f0 + r * b0, b0n = b0 + r * f0;
-    const double f1n = f1 + r * b1, b1n = b1 + r * f1;
+    const V f0 = f[i], b0 = b[i - 1], f1 = f[i - 1], b1 = b[i - 2];
+    const V f0n = f0 + r * b0, b0n = b0 + r * f0;
+    const V f1n = f1 + r * b1, b1n = b1 + r * f1;
     s.num += f[i + 1] * b0n;
     s.den += f[i + 1] * f[i + 1] + b0n * b0n;
     num2 += f0n * b1n;
@@ -66,8 +75,8 @@ StageSums next_stage(double* f, double* b, int n, int k, double r) {
     f[i] = f0n, b[i] = b0n, f[i - 1] = f1n, b[i - 1] = b1n;
   }
   for (; i >= k; --i) {
-    const double fi = f[i], bi = b[i - 1];
-    const double f_new = fi + r * bi, b_new = bi + r * fi;
+    const V fi = f[i], bi = b[i - 1];
+    const V f_new = fi + r * bi, b_new = bi + r * fi;
     s.num += f[i + 1] * b_new;
     s.den += f[i + 1] * f[i + 1] + b_new * b_new;
     f[i] = f_new, b[i] = b_new;
@@ -77,36 +86,87 @@ StageSums next_stage(double* f, double* b, int n, int k, double r) {
   return s;
 }
 
+double lane(double v, int) { return v; }
+double lane(Lanes v, int l) { return v[l]; }
+
+/// Burg's recursion on `axes` signals at once, held in f and b (e_0^f = e_0^b = x), their
+/// energies given. V is double (one axis) or Lanes (up to three).
+template <class V>
+[[gnu::always_inline]] inline void burg_stages(V* f, V* b, int n, int order, const double* energy,
+                                               int axes, BurgResult* out) {
+  double e[3];
+  for (int l = 0; l < axes; ++l) {
+    e[l] = energy[l] / n;  // E_0
+    out[l].reflection_coeffs.reserve(static_cast<size_t>(order));
+    out[l].error_power.reserve(static_cast<size_t>(order) + 1);
+    out[l].coefficients.reserve(static_cast<size_t>(order));
+    out[l].error_power.push_back(e[l]);
+  }
+  StageSums<V> sums = first_stage_sums(f, b, n);
+  for (int k = 1; k <= order; ++k) {
+    V r{};
+    for (int l = 0; l < axes; ++l) {
+      const double rl = reflection(lane(sums.num, l), lane(sums.den, l), energy[l]);
+      if constexpr (std::is_same_v<V, double>)
+        r = rl;
+      else
+        r[l] = rl;
+      update_coefficients(out[l].coefficients, rl, k);
+      e[l] *= (1 - rl * rl);  // E_k = E_{k-1} (1 - r_k^2)
+      out[l].reflection_coeffs.push_back(rl);
+      out[l].error_power.push_back(e[l]);
+    }
+    if (k == order) break;  // the last stage's errors and sums would not be used
+    sums = next_stage(f, b, n, k, r);
+  }
+}
+
+/// The three axes' recursion, compiled for AVX2 (one instruction for the three) and for the
+/// baseline; the loader picks the clone the CPU runs. The stages are inlined into each clone.
+/// f and b: n Lanes each, aligned to 32 bytes, filled here with the three signals.
+__attribute__((target_clones("avx2", "default"))) void burg_three(
+    const std::array<const double*, 3>& x, Lanes* f, Lanes* b, int n, int order, BurgResult* out) {
+  Lanes energy{};  // each lane summed in index order, as burg() sums its one signal
+  for (int i = 0; i < n; ++i) {
+    const Lanes v{x[0][i], x[1][i], x[2][i], 0};
+    f[i] = b[i] = v;  // eq. 33, 34: e_0^f = e_0^b = x
+    energy += v * v;
+  }
+  const double e[3] = {energy[0], energy[1], energy[2]};
+  burg_stages(f, b, n, order, e, 3, out);
+}
+
+void check(int n, int order) {
+  if (order < 1 || n <= order)
+    throw std::invalid_argument("burg: needs more samples than the order");
+}
+
 }  // namespace
 
 BurgResult burg(const double* x, int n, int order) {
-  if (order < 1 || n <= order)
-    throw std::invalid_argument("burg: needs more samples than the order");
+  check(n, order);
   // Forward and backward errors, reused between calls (the predictor calls this every sample).
   thread_local std::vector<double> f_buffer, b_buffer;
   f_buffer.assign(x, x + n);  // eq. 33, 34: e_0^f = e_0^b = x
   b_buffer.assign(x, x + n);
-  double* const f = f_buffer.data();  // plain pointers: no thread-local lookups in the loops
-  double* const b = b_buffer.data();
-  BurgResult out;
-  out.reflection_coeffs.reserve(static_cast<size_t>(order));
-  out.error_power.reserve(static_cast<size_t>(order) + 1);
   double energy = 0;
   for (int i = 0; i < n; ++i) energy += x[i] * x[i];
-  double e = energy / n;  // E_0
-  out.error_power.push_back(e);
-  StageSums sums = first_stage_sums(f, b, n);
-  std::vector<double>& a = out.coefficients;
-  a.reserve(static_cast<size_t>(order));
-  for (int k = 1; k <= order; ++k) {
-    const double r = reflection(sums, energy);
-    update_coefficients(a, r, k);
-    e *= (1 - r * r);  // E_k = E_{k-1} (1 - r_k^2)
-    out.reflection_coeffs.push_back(r);
-    out.error_power.push_back(e);
-    if (k == order) break;  // the last stage's errors and sums would not be used
-    sums = next_stage(f, b, n, k, r);
-  }
+  BurgResult out;
+  burg_stages(f_buffer.data(), b_buffer.data(), n, order, &energy, 1, &out);
+  return out;
+}
+
+std::array<BurgResult, 3> burg3(const std::array<const double*, 3>& x, int n, int order) {
+  check(n, order);
+  // Four doubles a sample in memory aligned to 32 bytes (a std::vector of a vector type would
+  // lose the type's alignment: GCC drops attributes on template arguments).
+  thread_local std::vector<double> memory;
+  memory.resize(8 * static_cast<size_t>(n) + 4);
+  const auto at = reinterpret_cast<uintptr_t>(memory.data());
+  Lanes* const f = reinterpret_cast<Lanes*>((at + 31) / 32 * 32);
+  Lanes* const b = f + n;
+  std::array<BurgResult, 3> out;
+  burg_three(x, f, b, n, order, out.data());
   return out;
 }
 

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <vector>
 
 namespace sg::predictor {
@@ -22,6 +23,11 @@ struct BurgResult {
 /// exactly predictable signal), the remaining reflection coefficients are 0 instead of 0/0.
 /// Needs n > order.
 BurgResult burg(const double* x, int n, int order);
+
+/// burg() of three signals (the x, y and z windows) in one pass: the same operations on the three
+/// at once, in the lanes of one AVX2 register, so each result is bit for bit burg()'s (a test)
+/// for about the time of one (issue 19). Needs n > order.
+std::array<BurgResult, 3> burg3(const std::array<const double*, 3>& x, int n, int order);
 
 /// One-step prediction of eq. 27 from the last p values of `history` (oldest first):
 /// -sum_k a_k history[size - k].

@@ -20,8 +20,8 @@ std::vector<Measurement> read_training_log(const std::string& path, const std::s
 /// Burg coefficients trained offline per axis (section 5.5, eq. 27-31).
 struct TrainedCoefficients {
   int order = 0;
-  double period = 0;  ///< s
-  int samples = 0;    ///< on the period grid, per axis
+  double period = 0;                                ///< s
+  int samples = 0;                                  ///< on the period grid, per axis
   std::array<std::vector<double>, 3> coefficients;  ///< a_1..a_p per axis
   std::array<std::vector<double>, 3> error_power;   ///< E_0..E_p per axis
 };

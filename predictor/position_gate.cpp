@@ -32,12 +32,12 @@ std::optional<PositionRefusal> PositionGate::check(const Measurement& m, int64_t
   if (limit > 0 && (m.utime > now ? static_cast<uint64_t>(m.utime) - static_cast<uint64_t>(now)
                                   : static_cast<uint64_t>(now) - static_cast<uint64_t>(m.utime)) >
                        static_cast<uint64_t>(limit)) {
-    return refuse(PositionRefusal::kTimeFarFromNow,
-                  "capture time " + std::to_string(m.utime) + " us is " +
-                      std::to_string((static_cast<double>(m.utime) - static_cast<double>(now)) *
-                                     1e-6) +
-                      " s from the receiver's clock (at most " +
-                      std::to_string(static_cast<double>(limit) * 1e-6) + " s)");
+    return refuse(
+        PositionRefusal::kTimeFarFromNow,
+        "capture time " + std::to_string(m.utime) + " us is " +
+            std::to_string((static_cast<double>(m.utime) - static_cast<double>(now)) * 1e-6) +
+            " s from the receiver's clock (at most " +
+            std::to_string(static_cast<double>(limit) * 1e-6) + " s)");
   }
   if (!m.visible) return std::nullopt;
   if (!m.position.allFinite()) {
@@ -46,9 +46,9 @@ std::optional<PositionRefusal> PositionGate::check(const Measurement& m, int64_t
   const Eigen::Vector3d lo = params_.box_min.array() - params_.margin;
   const Eigen::Vector3d hi = params_.box_max.array() + params_.margin;
   if (!((m.position.array() >= lo.array()).all() && (m.position.array() <= hi.array()).all())) {
-    return refuse(PositionRefusal::kOutsideWorkspace,
-                  "position " + xyz(m.position) + " m outside the workspace " + xyz(lo) + " .. " +
-                      xyz(hi) + " m");
+    return refuse(PositionRefusal::kOutsideWorkspace, "position " + xyz(m.position) +
+                                                          " m outside the workspace " + xyz(lo) +
+                                                          " .. " + xyz(hi) + " m");
   }
   return std::nullopt;
 }

@@ -27,7 +27,7 @@ struct PositionGateParams {
   /// sg-predictor reads it with load_arm_geometry). Unbounded by default.
   Eigen::Vector3d box_min = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
   Eigen::Vector3d box_max = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  double margin = 0.25;                  ///< m the ball may be outside the box on every side
+  double margin = 0.25;                    ///< m the ball may be outside the box on every side
   int64_t max_time_offset_us = 5'000'000;  ///< |utime - now| allowed; 0: not checked
 };
 

@@ -37,14 +37,17 @@ TrajectoryPredictor::TrajectoryPredictor(const PredictorParams& p)
 }
 
 void TrajectoryPredictor::reset() {
-  for (int i = 0; i < 3; ++i) {
-    BurgParams b = params_.burg;
-    if (!params_.initial_coefficients[static_cast<size_t>(i)].empty())
-      b.initial_coefficients = params_.initial_coefficients[static_cast<size_t>(i)];
-    axes_[static_cast<size_t>(i)] = params_.model == Model::kBurg ? make_burg_axis(b)
-                                    : params_.model == Model::kKalman
-                                        ? make_kalman_axis(params_.kalman)
-                                        : make_hold_axis();
+  if (params_.model == Model::kBurg) {
+    std::array<BurgParams, 3> b{params_.burg, params_.burg, params_.burg};
+    for (size_t i = 0; i < 3; ++i)
+      if (!params_.initial_coefficients[i].empty())
+        b[i].initial_coefficients = params_.initial_coefficients[i];
+    model_ = make_burg_trajectory(b);
+  } else {
+    std::array<std::unique_ptr<AxisModel>, 3> axes;
+    for (auto& a : axes)
+      a = params_.model == Model::kKalman ? make_kalman_axis(params_.kalman) : make_hold_axis();
+    model_ = make_axes_trajectory(std::move(axes));
   }
   started_ = false;
   have_seen_ = false;
@@ -55,27 +58,27 @@ void TrajectoryPredictor::reset() {
 }
 
 Eigen::Vector3d TrajectoryPredictor::one_step() const {
-  Eigen::Vector3d p;
-  for (int i = 0; i < 3; ++i) p[i] = axes_[static_cast<size_t>(i)]->forecast(1).front();
-  return p;
+  const std::array<std::vector<double>, 3> next = model_->forecast(1);
+  return {next[0].front(), next[1].front(), next[2].front()};
 }
 
 Forecast TrajectoryPredictor::emit_sample(int64_t grid, const Eigen::Vector3d& value, bool measured,
                                           int64_t source) {
   if (measured && occluded_ > 0) {  // back from an occlusion: the gap becomes the straight line
+    std::array<std::vector<double>, 3> line;
     for (int i = 0; i < 3; ++i) {
-      std::vector<double> line;
       for (int k = 1; k <= occluded_; ++k) {
         const double s = static_cast<double>(k) / (occluded_ + 1);
-        line.push_back(last_real_value_[i] + s * (value[i] - last_real_value_[i]));
+        line[static_cast<size_t>(i)].push_back(last_real_value_[i] +
+                                               s * (value[i] - last_real_value_[i]));
       }
-      axes_[static_cast<size_t>(i)]->replace_newest(line);
     }
+    model_->replace_newest(line);
     last_gap_ = occluded_;
     since_gap_ = 0;
     occluded_ = 0;
   }
-  for (int i = 0; i < 3; ++i) axes_[static_cast<size_t>(i)]->push(value[i], measured);
+  model_->push({value[0], value[1], value[2]}, measured);
   if (measured) error_.score(grid, value, measured_sigma_);
   if (measured) {
     last_real_grid_ = grid;
@@ -93,9 +96,7 @@ Forecast TrajectoryPredictor::emit_sample(int64_t grid, const Eigen::Vector3d& v
   f.status = status_;
   f.sample = value;
   last_sample_ = value;
-  std::array<std::vector<double>, 3> axis;
-  for (int i = 0; i < 3; ++i)
-    axis[static_cast<size_t>(i)] = axes_[static_cast<size_t>(i)]->forecast(params_.horizon);
+  const std::array<std::vector<double>, 3> axis = model_->forecast(params_.horizon);
   // The samples the published sigma counts past a measurement (PredictorParams::after_gap).
   const int unseen = occluded_ > 0 ? occluded_ : since_gap_ < params_.after_gap ? last_gap_ : 0;
   if (measured && since_gap_ < params_.after_gap) ++since_gap_;

@@ -130,7 +130,7 @@ class TrajectoryPredictor {
   bool outside_gate(const Measurement& m);
 
   PredictorParams params_;
-  std::array<std::unique_ptr<AxisModel>, 3> axes_;
+  std::unique_ptr<TrajectoryModel> model_;  // the three axes
   ForecastError error_;
   Eigen::Vector3d measured_sigma_ = Eigen::Vector3d::Zero();  // of the measurement being added
   uint64_t rejected_ = 0;
