@@ -1,0 +1,219 @@
+// The frame path through the real processes (issue 19): stereo frames published on CAMERA_LEFT and
+// CAMERA_RIGHT, stamped with the time they are published, go over LCM (UDP multicast, this
+// host) to sg-vision and sg-predictor, started as processes; this program times OBJECT_POSITION
+// and OBJECT_TRAJECTORY as they arrive (their receive time less the frames' utime) and reads
+// sg-vision's own figure, second image received -> OBJECT_POSITION published, from its summary.
+// Three runs: JPEG with only the search windows decoded (vision.decode: region, the default),
+// JPEG decoded whole (the baseline), raw BGR8. The frames are the simulated lab's, rendered and
+// encoded before the run (sg-camera-sim's encoder), so rendering is not timed.
+//
+//   scripts/multicast.sh run build/bin/frame_path_latency [--pairs 300] [--rate 20]
+//
+// Goals (issue 19): sg-vision's own added latency p99 <= 1.5 ms (JPEG, windows decoded).
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <thread>
+
+#include "common/bus.hpp"
+#include "common/clock.hpp"
+#include "common/latency_record.hpp"
+#include "common/message_types.hpp"
+#include "sim/camera_simulator.hpp"
+#include "vision/calibration_file.hpp"
+#include "vision/image_message.hpp"
+
+extern char** environ;
+
+namespace {
+
+using namespace std::chrono_literals;
+using stereograsp::image_t;
+
+/// A product program as a child process, its standard output to a file; SIGINT when it goes.
+class Program {
+ public:
+  Program(const std::string& name, std::vector<std::string> args, const std::string& out)
+      : out_(out) {
+    const std::string bin = std::string(SG_BIN_DIR) + "/" + name;
+    args.insert(args.begin(), bin);
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t files;
+    posix_spawn_file_actions_init(&files);
+    posix_spawn_file_actions_addopen(&files, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int e = posix_spawn(&pid_, bin.c_str(), &files, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&files);
+    if (e != 0) throw std::runtime_error("cannot start " + bin);
+  }
+  ~Program() { stop(); }
+  /// SIGINT, then waits; returns its standard output.
+  std::string stop() {
+    if (pid_ > 0) {
+      kill(pid_, SIGINT);
+      waitpid(pid_, nullptr, 0);
+      pid_ = -1;
+    }
+    std::ifstream f(out_);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+  }
+
+ private:
+  pid_t pid_ = -1;
+  std::string out_;
+};
+
+struct Frames {
+  std::vector<std::array<image_t, 2>> jpeg, raw;
+};
+
+/// 60 frames of the simulated lab, JPEG and raw; the cameras written as the calibration.
+Frames render(const std::string& calibration) {
+  const sg::sim::SimParams params;
+  sg::sim::CameraSimulator sim(params);
+  sg::vision::StereoCalibration c;
+  c.left = sim.camera(0), c.right = sim.camera(1), c.source = "frame_path_latency";
+  sg::vision::write_calibration(calibration, c);
+  Frames f;
+  sg::sim::StereoFrame frame;
+  for (int64_t n = 0; n < 60; ++n) {
+    sim.render(n, {}, frame);
+    std::array<image_t, 2> j, r;
+    for (size_t i = 0; i < 2; ++i) {
+      j[i] = sg::vision::encode_image(frame.image[i], static_cast<int8_t>(i), n, 0, true);
+      r[i] = sg::vision::encode_image(frame.image[i], static_cast<int8_t>(i), n, 0, false);
+    }
+    f.jpeg.push_back(j), f.raw.push_back(r);
+  }
+  return f;
+}
+
+struct Run {
+  std::string name;
+  sg::LatencyRecord position, trajectory;
+  std::string vision_own;  ///< sg-vision's summary line
+};
+
+/// Waits until both processes announce themselves on PROCESS_STATUS.
+bool wait_ready(sg::Bus& bus, bool& vision, bool& predictor) {
+  const auto end = std::chrono::steady_clock::now() + 20s;
+  while (!(vision && predictor) && std::chrono::steady_clock::now() < end) bus.handle(50ms);
+  return vision && predictor;
+}
+
+/// One run: the two programs, `pairs` frames at `rate` Hz, what arrived.
+void run(const std::string& url, const std::string& dir,
+         const std::vector<std::array<image_t, 2>>& frames, const std::string& decode, int pairs,
+         double rate, Run& out) {
+  sg::Bus bus(url);
+  bool vision_up = false, predictor_up = false;
+  bus.subscribe<stereograsp::process_status_t>("PROCESS_STATUS", [&](const auto& m, const auto&) {
+    vision_up |= m.process == "sg-vision", predictor_up |= m.process == "sg-predictor";
+  });
+  bus.subscribe<stereograsp::point3_t>("OBJECT_POSITION", [&](const auto& m, const auto& info) {
+    out.position.add(info.recv_utime - m.utime);
+  });
+  bus.subscribe<stereograsp::trajectory_t>("OBJECT_TRAJECTORY",
+                                           [&](const auto& m, const auto& info) {
+                                             out.trajectory.add(info.recv_utime - m.source_utime);
+                                           });
+  Program vision("sg-vision",
+                 {"--calibration", dir + "/cams.yaml", "--decode", decode, "--lcm-url", url,
+                  "--log-level", "warn"},
+                 dir + "/vision.out");
+  Program predictor("sg-predictor",
+                    {"--config", dir + "/predictor.yaml", "--lcm-url", url, "--log-level", "warn"},
+                    dir + "/predictor.out");
+  if (!wait_ready(bus, vision_up, predictor_up))
+    throw std::runtime_error("the programs did not start");
+  const auto period = std::chrono::duration<double>(1.0 / rate);
+  auto next = std::chrono::steady_clock::now();
+  for (int k = 0; k < pairs; ++k) {
+    const size_t n = frames.size(), at = static_cast<size_t>(k) % (2 * n - 2);
+    std::array<image_t, 2> pair = frames[at < n ? at : 2 * n - 2 - at];  // forwards and back
+    const int64_t now = sg::now_utime();
+    for (size_t i = 0; i < 2; ++i) {
+      pair[i].utime = now, pair[i].frame_number = k;
+      bus.publish(i == 0 ? "CAMERA_LEFT" : "CAMERA_RIGHT", pair[i]);
+    }
+    next += std::chrono::duration_cast<std::chrono::steady_clock::duration>(period);
+    while (std::chrono::steady_clock::now() < next)
+      bus.handle(std::chrono::duration_cast<std::chrono::milliseconds>(
+                     next - std::chrono::steady_clock::now()) +
+                 1ms);
+  }
+  const auto end = std::chrono::steady_clock::now() + 1s;  // the last ones in flight
+  while (std::chrono::steady_clock::now() < end) bus.handle(50ms);
+  const std::string text = vision.stop();
+  predictor.stop();
+  std::smatch m;
+  if (std::regex_search(text, m, std::regex("OBJECT_POSITION published: ([^\n]*)")))
+    out.vision_own = m[1];
+}
+
+void print(const Run& r) {
+  auto ms = [](const sg::LatencyRecord& l, double p) {
+    return l.count() ? l.percentile(p) / 1000.0 : 0.0;
+  };
+  std::printf("%-22s %6llu  %7.2f %7.2f   %8llu  %7.2f %7.2f   %s\n", r.name.c_str(),
+              static_cast<unsigned long long>(r.position.count()), ms(r.position, 0.5),
+              ms(r.position, 0.99), static_cast<unsigned long long>(r.trajectory.count()),
+              ms(r.trajectory, 0.5), ms(r.trajectory, 0.99), r.vision_own.c_str());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "Camera message -> OBJECT_POSITION -> OBJECT_TRAJECTORY through sg-vision and "
+      "sg-predictor, with JPEG (windows or whole) and raw frames."};
+  int pairs = 300;
+  double rate = 20;
+  // Raw frames are 0.9 MB: LCM's default socket buffer drops their fragments (recv_buf_size).
+  std::string url = "udpm://239.255.76.67:7961?ttl=0&recv_buf_size=16777216";
+  app.add_option("--pairs", pairs, "stereo pairs a run")->check(CLI::Range(10, 100000));
+  app.add_option("--rate", rate, "pairs a second (the predictor's period is set to match)")
+      ->check(CLI::Range(1.0, 100.0));
+  app.add_option("--lcm-url", url, "the bus (this host only: ttl=0)");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    const std::string dir =
+        std::filesystem::temp_directory_path() / ("frame_path_" + std::to_string(getpid()));
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir + "/predictor.yaml") << "predictor:\n  period: " << 1.0 / rate << "\n";
+    std::printf("rendering and encoding 60 stereo frames...\n");
+    const Frames frames = render(dir + "/cams.yaml");
+    std::vector<Run> runs(3);
+    runs[0].name = "JPEG, windows decoded", runs[1].name = "JPEG, whole frames",
+    runs[2].name = "raw BGR8";
+    run(url, dir, frames.jpeg, "region", pairs, rate, runs[0]);
+    run(url, dir, frames.jpeg, "full", pairs, rate, runs[1]);
+    run(url, dir, frames.raw, "region", pairs, rate, runs[2]);
+    std::printf("\n%d pairs at %.0f Hz, one host, ms from the frames' publication (utime):\n",
+                pairs, rate);
+    std::printf("%-22s %6s  %7s %7s   %8s  %7s %7s   %s\n", "frames", "points", "p50", "p99",
+                "trajects", "p50", "p99",
+                "sg-vision's own: second image received -> OBJECT_POSITION");
+    for (const Run& r : runs) print(r);
+    std::filesystem::remove_all(dir);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "frame_path_latency: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
