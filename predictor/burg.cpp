@@ -54,7 +54,7 @@ void update_coefficients(std::vector<double>& a, double r, int k) {
 /// when b[n] is written), and stage k+1's sums of eq. 30 in the same pass: f[n+1] b[n] once b[n]
 /// is new. Returns those sums.
 template <class V>
-[[gnu::always_inline]] inline StageSums<V> next_stage(V* f, V* b, int n, int k, V r) {
+[[gnu::always_inline]] inline StageSums<V> next_stage(V* f, V* b, int n, int k, const V& r) {
   StageSums<V> s;
   {
     const V fi = f[n - 1], bi = b[n - 2];  // the top: no f[i+1] yet
@@ -87,7 +87,7 @@ template <class V>
 }
 
 double lane(double v, int) { return v; }
-double lane(Lanes v, int l) { return v[l]; }
+double lane(const Lanes& v, int l) { return v[l]; }
 
 /// Burg's recursion on `axes` signals at once, held in f and b (e_0^f = e_0^b = x), their
 /// energies given. V is double (one axis) or Lanes (up to three).
