@@ -33,6 +33,7 @@ packages=(
   default-jdk-headless default-jre libjchart2d-java  # the types jar, lcm-spy and its charts
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev  # config, flags, logging
   libeigen3-dev                                    # linear algebra
+  libhwy-dev                                       # Highway: SIMD kernels, dispatched at run time
   libopencv-dev                                    # images, video files, calibration
   opencv-doc                                       # real photographs and video (real-scene tests)
   libturbojpeg0-dev                                # a JPEG's size from its header, before decoding

@@ -10,6 +10,12 @@ namespace {
 
 int64_t fixed(double v) { return std::llround(std::clamp(v, 0.0, 1.0) * 65536.0); }
 
+/// ColorBounds's q for a bound of 2^16 q_fixed: 2^16 itself is `always`.
+void set_bound(ColorBounds& k, int i, int64_t q) {
+  k.q[i] = static_cast<uint16_t>(q & 0xffff);
+  k.always[i] = q >= 65536 ? 0x7fff : 0;
+}
+
 }  // namespace
 
 ColorDetector::ColorDetector(const ColorThresholds& t)
@@ -26,6 +32,11 @@ ColorDetector::ColorDetector(const ColorThresholds& t)
   }
   if (t.r_min > t.r_max || t.g_min > t.g_max || t.b_min > t.b_max)
     throw std::invalid_argument("colour thresholds: a minimum is above its maximum");
+  const int64_t one = kOne;
+  set_bound(bounds_, 0, r_hi_), set_bound(bounds_, 1, one - r_lo_);
+  set_bound(bounds_, 2, g_hi_), set_bound(bounds_, 3, one - g_lo_);
+  set_bound(bounds_, 4, b_hi_), set_bound(bounds_, 5, one - b_lo_);
+  bounds_.min_sum = static_cast<int16_t>(std::min<int64_t>(min_sum_, 766));
 }
 
 ColorThresholds ColorThresholds::learn(const cv::Mat& bgr, const cv::Rect& roi, double margin,
@@ -59,31 +70,6 @@ ColorThresholds ColorThresholds::learn(const cv::Mat& bgr, const cv::Rect& roi, 
   range(b, t.b_min, t.b_max);
   t.min_intensity = std::max(30, min_sum / 2);
   return t;
-}
-
-namespace {
-
-/// The row kernel, one clone per instruction set; the loader picks the best the CPU has.
-__attribute__((target_clones("avx2", "default"))) void classify_row(
-    const uint8_t* __restrict bgr, int n, uint8_t* __restrict mask, int32_t r_lo, int32_t r_hi,
-    int32_t g_lo, int32_t g_hi, int32_t b_lo, int32_t b_hi, int32_t min_sum) {
-  constexpr int32_t kOne = 1 << 16;
-  for (int i = 0; i < n; ++i) {
-    const int32_t b = bgr[3 * i], g = bgr[3 * i + 1], r = bgr[3 * i + 2];
-    const int32_t sum = b + g + r;
-    mask[i] = static_cast<uint8_t>((sum >= min_sum) & (r * kOne >= r_lo * sum) &
-                                   (g * kOne <= g_hi * sum) & (b * kOne <= b_hi * sum) &
-                                   (r * kOne <= r_hi * sum) & (g * kOne >= g_lo * sum) &
-                                   (b * kOne >= b_lo * sum));
-  }
-}
-
-}  // namespace
-
-void ColorDetector::classify(const uint8_t* bgr, int n, uint8_t* mask) const {
-  auto c = [](int64_t v) { return static_cast<int32_t>(v); };  // all in [0, 65536]
-  classify_row(bgr, n, mask, c(r_lo_), c(r_hi_), c(g_lo_), c(g_hi_), c(b_lo_), c(b_hi_),
-               c(min_sum_));
 }
 
 }  // namespace sg::vision

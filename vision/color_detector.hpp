@@ -21,6 +21,18 @@ struct ColorThresholds {
                                double keep = 0.90);
 };
 
+/// ColorDetector's bounds as classify()'s SIMD lanes use them. Each bound of eq. 8 is
+/// X <= floor(q S / 2^16), S = B+G+R, X an integer: an upper bound r <= r_max is X = R with
+/// q = round(2^16 r_max); a lower one, r >= r_min, is the same as (G+B) 2^16 <= (2^16 - q_min) S,
+/// so X = G+B with q = 2^16 - round(2^16 r_min). floor(q S / 2^16) is the high half of a 16-bit
+/// product; q = 2^16 (a bound that always holds: X <= S) is q = 0 with `always` set instead.
+/// Order: R, G+B, G, R+B, B, R+G.
+struct ColorBounds {
+  uint16_t q[6] = {};
+  uint16_t always[6] = {};  ///< 0x7fff where the bound always holds, else 0
+  int16_t min_sum = 1;      ///< R+G+B below it fails (at most 766: never)
+};
+
 /// The paper's threshold (eq. 8) on normalized RGB (eq. 7), in integer arithmetic with no
 /// division: r >= r_min  <=>  2^16 R >= round(2^16 r_min) (R+G+B).
 ///
@@ -40,11 +52,13 @@ class ColorDetector {
            r * kOne <= r_hi_ * sum && g * kOne >= g_lo_ * sum && b * kOne >= b_lo_ * sum;
   }
 
-  /// is_object() of `n` pixels at once: mask[i] = 1 for the object's colour, else 0. The same
-  /// integer test in 32-bit lanes (every product fits: 255 x 2^16 and 2^16 x 765), with no
-  /// branch, so the compiler vectorizes it: built with -O3 for AVX2 and for the baseline
-  /// (target_clones, chosen when the program loads). Bit for bit is_object() (a test).
-  void classify(const uint8_t* bgr, int n, uint8_t* mask) const;
+  /// is_object() of `n` pixels at once, as bits: bit i % 64 of bits[i / 64] is set for the
+  /// object's colour; the ceil(n / 64) words are all written (bits past n clear). The bounds as
+  /// ColorBounds in 16-bit SIMD lanes (Highway: SSE4, AVX2 or AVX-512, whichever the CPU has),
+  /// bit for bit is_object() (a test, over every colour and every compiled instruction set).
+  /// `readable`: pixels that may be read from `bgr` (at least n; the rest of an image's row), so
+  /// the last vector is read in place rather than copied.
+  void classify(const uint8_t* bgr, int n, uint64_t* bits, int readable = 0) const;
 
   const ColorThresholds& thresholds() const { return t_; }
 
@@ -52,6 +66,7 @@ class ColorDetector {
   static constexpr int64_t kOne = 1 << 16;
   ColorThresholds t_;
   int64_t r_lo_, r_hi_, g_lo_, g_hi_, b_lo_, b_hi_, min_sum_;
+  ColorBounds bounds_;
 };
 
 }  // namespace sg::vision

@@ -18,7 +18,7 @@ Segmenter::Segmenter(cv::Size max_size, Kernel kernel) : max_size_(max_size), ke
   if (kernel_ == Kernel::kRuns) {
     runs_.resize(labels);
     row_start_.resize(rows + 1);
-    row_mask_.resize(static_cast<size_t>(max_size.width) + 8);
+    row_bits_.resize(static_cast<size_t>(max_size.width) / 64 + 1);
   }
 }
 
@@ -97,17 +97,15 @@ void Segmenter::label_window(const cv::Mat& bgr, const ColorDetector& detector) 
 
 namespace {
 
-/// The first x in [x, n) where the mask is `set` (n when none), eight bytes at a time.
-int next_where(const uint8_t* mask, int x, int n, bool set) {
-  static_assert(std::endian::native == std::endian::little, "the byte order ctz reads");
-  const uint64_t flip = set ? 0 : 0x0101010101010101ull;
-  for (; x + 8 <= n; x += 8) {
-    uint64_t v;
-    std::memcpy(&v, mask + x, 8);
-    if ((v ^= flip) != 0) return x + __builtin_ctzll(v) / 8;
+/// The first x in [x, n) where the row's bit is `set` (n when none), 64 pixels a step.
+int next_where(const uint64_t* bits, int x, int n, bool set) {
+  const uint64_t flip = set ? 0 : ~uint64_t{0};
+  while (x < n) {
+    const uint64_t v = (bits[x / 64] ^ flip) >> (x % 64);
+    if (v != 0) return std::min(n, x + std::countr_zero(v));
+    x = (x / 64 + 1) * 64;
   }
-  while (x < n && (mask[x] != 0) != set) ++x;
-  return x;
+  return n;
 }
 
 /// Sum of k^2 for k in [0, x].
@@ -145,13 +143,13 @@ void Segmenter::label_runs(const cv::Mat& bgr, const ColorDetector& detector) {
   size_t count = 0;
   for (int y = 0; y < w.height; ++y) {
     const uint8_t* in = bgr.ptr<uint8_t>(w.y + y) + 3 * w.x;
-    detector.classify(in, w.width, row_mask_.data());
+    detector.classify(in, w.width, row_bits_.data(), bgr.cols - w.x);
     size_t above = y > 0 ? row_start_[static_cast<size_t>(y - 1)] : 0;
     const size_t above_end = count;
     row_start_[static_cast<size_t>(y)] = count;
-    for (int x0 = next_where(row_mask_.data(), 0, w.width, true); x0 < w.width;
-         x0 = next_where(row_mask_.data(), x0, w.width, true)) {
-      const int x1 = next_where(row_mask_.data(), x0, w.width, false);
+    for (int x0 = next_where(row_bits_.data(), 0, w.width, true); x0 < w.width;
+         x0 = next_where(row_bits_.data(), x0, w.width, true)) {
+      const int x1 = next_where(row_bits_.data(), x0, w.width, false);
       int32_t label = y > 0 ? label_of_run(x0, x1, above, above_end) : 0;
       if (label == 0) {
         label = next_++;

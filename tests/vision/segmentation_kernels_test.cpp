@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <hwy/targets.h>
+
 #include <opencv2/imgcodecs.hpp>
 #include <random>
 #include <string>
@@ -28,24 +30,62 @@ std::vector<ColorThresholds> threshold_sets() {
   return v;
 }
 
-// Every one of the 2^24 colours: classify() says what is_object() says.
+/// classify()'s bit for pixel i.
+bool bit(const std::vector<uint64_t>& bits, size_t i) { return (bits[i / 64] >> (i % 64)) & 1; }
+
+// Every one of the 2^24 colours, with every instruction set Highway compiled that this CPU has:
+// classify() says what is_object() says.
 TEST(ColorKernels, ClassifyIsIsObjectForEveryColour) {
-  std::vector<uint8_t> bgr(size_t{3} << 24), mask(size_t{1} << 24);
-  for (size_t i = 0; i < mask.size(); ++i) {
+  const size_t n = size_t{1} << 24;
+  std::vector<uint8_t> bgr(3 * n);
+  std::vector<uint64_t> bits(n / 64);
+  for (size_t i = 0; i < n; ++i) {
     bgr[3 * i] = static_cast<uint8_t>(i), bgr[3 * i + 1] = static_cast<uint8_t>(i >> 8);
     bgr[3 * i + 2] = static_cast<uint8_t>(i >> 16);
   }
-  for (const ColorThresholds& t : threshold_sets()) {
-    const ColorDetector d(t);
-    d.classify(bgr.data(), static_cast<int>(mask.size()), mask.data());
-    size_t wrong = 0, objects = 0;
-    for (size_t i = 0; i < mask.size(); ++i) {
-      const bool is = d.is_object(&bgr[3 * i]);
-      objects += is;
-      wrong += mask[i] != (is ? 1 : 0);
+  const std::vector<int64_t> targets = hwy::SupportedAndGeneratedTargets();
+  ASSERT_FALSE(targets.empty());
+  for (const int64_t target : targets) {
+    hwy::SetSupportedTargetsForTest(target);
+    for (const ColorThresholds& t : threshold_sets()) {
+      const ColorDetector d(t);
+      d.classify(bgr.data(), static_cast<int>(n), bits.data());
+      size_t wrong = 0, objects = 0;
+      for (size_t i = 0; i < n; ++i) {
+        const bool is = d.is_object(&bgr[3 * i]);
+        objects += is;
+        wrong += bit(bits, i) != is;
+      }
+      EXPECT_EQ(wrong, 0u) << hwy::TargetName(target) << ", r " << t.r_min << "-" << t.r_max
+                           << ", " << objects << " objects";
     }
-    EXPECT_EQ(wrong, 0u) << "r " << t.r_min << "-" << t.r_max << ", " << objects << " objects";
   }
+  hwy::SetSupportedTargetsForTest(0);
+}
+
+// Rows of every length up to three vectors, with every instruction set: the last pixels read in
+// place (the row goes on) and through the kernel's zeroed copy (it ends), and the bits past n,
+// which must be clear.
+TEST(ColorKernels, ClassifyEveryRowLength) {
+  std::mt19937 rng(19);
+  std::vector<uint8_t> bgr(3 * 400);
+  for (uint8_t& v : bgr) v = static_cast<uint8_t>(rng());
+  const ColorDetector d(threshold_sets()[1]);  // the widest: most pixels are the colour
+  for (const int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    for (int n = 1; n <= 200; ++n) {
+      for (const int readable : {n, 400}) {
+        std::vector<uint64_t> bits((n + 63) / 64, ~uint64_t{0});
+        d.classify(bgr.data(), n, bits.data(), readable);
+        for (size_t i = 0; i < bits.size() * 64; ++i) {
+          const bool want = i < static_cast<size_t>(n) && d.is_object(&bgr[3 * i]);
+          ASSERT_EQ(bit(bits, i), want) << hwy::TargetName(target) << ", n " << n << ", readable "
+                                        << readable << ", pixel " << i;
+        }
+      }
+    }
+  }
+  hwy::SetSupportedTargetsForTest(0);
 }
 
 void expect_same(const Segmentation& a, const Segmentation& b) {
