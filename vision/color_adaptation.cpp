@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "vision/order_statistic.hpp"
+
 namespace sg::vision {
 namespace {
 
@@ -21,12 +23,6 @@ void narrow(double conf_lo, double conf_hi, double learned_lo, double learned_hi
     if (lo < conf_lo) hi = std::min(conf_hi, hi + conf_lo - lo), lo = conf_lo;
     if (hi > conf_hi) lo = std::max(conf_lo, lo - (hi - conf_hi)), hi = conf_hi;
   }
-}
-
-double quantile_of(std::vector<float>& v, double q) {
-  const auto k = static_cast<size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
 }
 
 }  // namespace
@@ -56,7 +52,7 @@ bool ColorAdaptation::sample(const cv::Mat& bgr, const cv::Point2d& centre, doub
       if (dx * dx + dy * dy > reach2) continue;
       const uint8_t* px = row + 3 * x;
       const int sum = px[0] + px[1] + px[2];
-      if (sum < configured_.min_intensity) continue;
+      if (sum < std::max(1, configured_.min_intensity)) continue;  // a black pixel has no colour
       pixels_[0].push_back(static_cast<float>(px[2]) / static_cast<float>(sum));
       pixels_[1].push_back(static_cast<float>(px[1]) / static_cast<float>(sum));
       pixels_[2].push_back(static_cast<float>(px[0]) / static_cast<float>(sum));

@@ -51,12 +51,13 @@ HWY_INLINE auto object_lanes(D16 d16, V b, V g, V r, const ColorBounds& k) {
   return hn::RebindMask(d16, hn::Not(fail));
 }
 
-void ClassifyBits(const uint8_t* HWY_RESTRICT bgr, size_t n, size_t readable,
-                  uint64_t* HWY_RESTRICT bits, const ColorBounds& k) {
-  const hn::ScalableTag<uint16_t> d16;
-  const hn::Rebind<uint8_t, decltype(d16)> d8;
+/// One row: bits[i / 64] bit i % 64 for pixel i < n (the words were zeroed); pixels up to
+/// `readable` may be read.
+template <class D16>
+HWY_INLINE void classify_row(D16 d16, const uint8_t* HWY_RESTRICT bgr, size_t n, size_t readable,
+                             uint64_t* HWY_RESTRICT bits, const ColorBounds& k) {
+  const hn::Rebind<uint8_t, D16> d8;
   const size_t lanes = hn::Lanes(d16);
-  std::memset(bits, 0, (n + 63) / 64 * sizeof(uint64_t));
   hn::Vec<decltype(d8)> b8, g8, r8;
   size_t i = 0;
   for (; i + lanes <= n; i += lanes) {
@@ -70,11 +71,22 @@ void ClassifyBits(const uint8_t* HWY_RESTRICT bgr, size_t n, size_t readable,
   // black pixel is below any min_sum, which is at least 1); lanes past n masked off.
   alignas(64) uint8_t tail[3 * 64] = {};
   const uint8_t* last = bgr + 3 * i;
-  if (i + lanes > readable) last = static_cast<const uint8_t*>(std::memcpy(tail, last, 3 * (n - i)));
+  if (i + lanes > readable)
+    last = static_cast<const uint8_t*>(std::memcpy(tail, last, 3 * (n - i)));
   hn::LoadInterleaved3(d8, last, b8, g8, r8);
-  const auto ok = object_lanes(d16, hn::PromoteTo(d16, b8), hn::PromoteTo(d16, g8),
-                               hn::PromoteTo(d16, r8), k);
+  const auto ok =
+      object_lanes(d16, hn::PromoteTo(d16, b8), hn::PromoteTo(d16, g8), hn::PromoteTo(d16, r8), k);
   put_bits(d16, hn::And(ok, hn::FirstN(d16, n - i)), i, bits);
+}
+
+void ClassifyRows(const ClassifyRowsArgs& a, const ColorBounds& k) {
+  const hn::ScalableTag<uint16_t> d16;
+  const size_t words = (a.width + 63) / 64;
+  for (size_t y = 0; y < a.height; ++y) {
+    uint64_t* bits = a.bits + y * a.words_per_row;
+    std::memset(bits, 0, words * sizeof(uint64_t));
+    classify_row(d16, a.bgr + y * a.stride, a.width, a.readable, bits, k);
+  }
 }
 
 }  // namespace HWY_NAMESPACE
@@ -84,12 +96,17 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace sg::vision {
 
-HWY_EXPORT(ClassifyBits);
+HWY_EXPORT(ClassifyRows);
 
 void ColorDetector::classify(const uint8_t* bgr, int n, uint64_t* bits, int readable) const {
   if (n <= 0) return;
-  HWY_DYNAMIC_DISPATCH(ClassifyBits)
-  (bgr, static_cast<size_t>(n), static_cast<size_t>(std::max(n, readable)), bits, bounds_);
+  classify_rows(
+      {bgr, 0, static_cast<size_t>(n), 1, static_cast<size_t>(std::max(n, readable)), bits, 0});
+}
+
+void ColorDetector::classify_rows(const ClassifyRowsArgs& rows) const {
+  if (rows.width == 0 || rows.height == 0) return;
+  HWY_DYNAMIC_DISPATCH(ClassifyRows)(rows, bounds_);
 }
 
 }  // namespace sg::vision

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <opencv2/core.hpp>
 
@@ -33,6 +34,16 @@ struct ColorBounds {
   int16_t min_sum = 1;      ///< R+G+B below it fails (at most 766: never)
 };
 
+/// A block of rows for ColorDetector::classify_rows: `height` rows of `width` BGR pixels,
+/// `stride` bytes apart from `bgr`, each readable to pixel `readable` (>= width), their bits in
+/// rows of `words_per_row` 64-bit words from `bits`.
+struct ClassifyRowsArgs {
+  const uint8_t* bgr;
+  size_t stride, width, height, readable;
+  uint64_t* bits;
+  size_t words_per_row;
+};
+
 /// The paper's threshold (eq. 8) on normalized RGB (eq. 7), in integer arithmetic with no
 /// division: r >= r_min  <=>  2^16 R >= round(2^16 r_min) (R+G+B).
 ///
@@ -59,6 +70,8 @@ class ColorDetector {
   /// `readable`: pixels that may be read from `bgr` (at least n; the rest of an image's row), so
   /// the last vector is read in place rather than copied.
   void classify(const uint8_t* bgr, int n, uint64_t* bits, int readable = 0) const;
+  /// classify() of a block of rows (a search window) in one call.
+  void classify_rows(const ClassifyRowsArgs& rows) const;
 
   const ColorThresholds& thresholds() const { return t_; }
 

@@ -7,6 +7,8 @@
 namespace sg::vision {
 
 Segmenter::Segmenter(cv::Size max_size, Kernel kernel) : max_size_(max_size), kernel_(kernel) {
+  if (max_size.width < 0 || max_size.height < 0 || max_size.width >= (1 << 24))
+    throw std::invalid_argument("Segmenter: image size out of range");
   const size_t pixels = static_cast<size_t>(max_size.area());
   const size_t rows = static_cast<size_t>(max_size.height);
   // 8-connectivity: at most one new label (one run) every other pixel, half a pixel more a row
@@ -18,7 +20,8 @@ Segmenter::Segmenter(cv::Size max_size, Kernel kernel) : max_size_(max_size), ke
   if (kernel_ == Kernel::kRuns) {
     runs_.resize(labels);
     row_start_.resize(rows + 1);
-    row_bits_.resize(static_cast<size_t>(max_size.width) / 64 + 1);
+    bits_per_row_ = static_cast<size_t>(max_size.width) / 64 + 1;
+    window_bits_.resize(bits_per_row_ * rows);
   }
 }
 
@@ -120,7 +123,9 @@ void add_run(Region& r, int64_t xa, int64_t xb, int64_t y, const uint8_t* bgr) {
   r.x_min = std::min(r.x_min, static_cast<int>(xa)),
   r.x_max = std::max(r.x_max, static_cast<int>(xb));
   r.y_max = static_cast<int>(y);
-  for (int64_t i = 0; i < n; ++i, bgr += 3) r.sum_b += bgr[0], r.sum_g += bgr[1], r.sum_r += bgr[2];
+  uint32_t b = 0, g = 0, red = 0;  // a run is under 2^24 px (the constructor): no overflow
+  for (int64_t i = 0; i < 3 * n; i += 3) b += bgr[i], g += bgr[i + 1], red += bgr[i + 2];
+  r.sum_b += b, r.sum_g += g, r.sum_r += red;
 }
 
 }  // namespace
@@ -135,21 +140,25 @@ int32_t Segmenter::label_of_run(int x0, int x1, size_t& above, size_t above_end)
   return label;
 }
 
-// Row by row: classify, find the runs, label them against the row above, sum them.
+// The window classified in one call; then row by row: find the runs, label them against the
+// row above, sum them.
 void Segmenter::label_runs(const cv::Mat& bgr, const ColorDetector& detector) {
   const cv::Rect& w = window_;
   next_ = 1;
   parent_[0] = 0;
   size_t count = 0;
+  detector.classify_rows({bgr.ptr<uint8_t>(w.y) + 3 * w.x, bgr.step[0],
+                          static_cast<size_t>(w.width), static_cast<size_t>(w.height),
+                          static_cast<size_t>(bgr.cols - w.x), window_bits_.data(), bits_per_row_});
   for (int y = 0; y < w.height; ++y) {
     const uint8_t* in = bgr.ptr<uint8_t>(w.y + y) + 3 * w.x;
-    detector.classify(in, w.width, row_bits_.data(), bgr.cols - w.x);
+    const uint64_t* row_bits = window_bits_.data() + static_cast<size_t>(y) * bits_per_row_;
     size_t above = y > 0 ? row_start_[static_cast<size_t>(y - 1)] : 0;
     const size_t above_end = count;
     row_start_[static_cast<size_t>(y)] = count;
-    for (int x0 = next_where(row_bits_.data(), 0, w.width, true); x0 < w.width;
-         x0 = next_where(row_bits_.data(), x0, w.width, true)) {
-      const int x1 = next_where(row_bits_.data(), x0, w.width, false);
+    for (int x0 = next_where(row_bits, 0, w.width, true); x0 < w.width;
+         x0 = next_where(row_bits, x0, w.width, true)) {
+      const int x1 = next_where(row_bits, x0, w.width, false);
       int32_t label = y > 0 ? label_of_run(x0, x1, above, above_end) : 0;
       if (label == 0) {
         label = next_++;

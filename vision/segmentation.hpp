@@ -42,10 +42,10 @@ struct Segmentation {
 ///
 /// Two kernels give the same regions bit for bit (a test): kRuns, the default, classifies a row
 /// at a time with the vectorized ColorDetector::classify, finds the runs of the colour 64
-/// pixels at a time in its bits, labels runs (a run joins the runs above that touch it, 8-connected) and
-/// adds each run's moments in closed form (sum of x over [a, b] = (a + b)(b - a + 1) / 2, of x^2
-/// = S(b) - S(a - 1), S(k) = k (k + 1)(2k + 1) / 6); kPixels labels pixel by pixel, the
-/// reference. Labels are made in raster order in both, and a region's root is its smallest, so
+/// pixels at a time in its bits, labels runs (a run joins the runs above that touch it,
+/// 8-connected) and adds each run's moments in closed form (sum of x over [a, b] = (a + b)(b - a +
+/// 1) / 2, of x^2 = S(b) - S(a - 1), S(k) = k (k + 1)(2k + 1) / 6); kPixels labels pixel by pixel,
+/// the reference. Labels are made in raster order in both, and a region's root is its smallest, so
 /// the regions come out in the same order.
 ///
 ///     Segmenter segmenter(image_size);
@@ -89,9 +89,10 @@ class Segmenter {
   std::vector<uint8_t> mask_;    // mask_of()'s pixels
   cv::Size max_size_;
   Kernel kernel_;
-  std::vector<Run> runs_;          // kRuns: the window's runs, row by row
-  std::vector<size_t> row_start_;  // kRuns: each row's first run, and the end
-  std::vector<uint64_t> row_bits_;  // kRuns: classify()'s output for one row
+  std::vector<Run> runs_;              // kRuns: the window's runs, row by row
+  std::vector<size_t> row_start_;      // kRuns: each row's first run, and the end
+  size_t bits_per_row_ = 0;            // kRuns: words a row of window_bits_
+  std::vector<uint64_t> window_bits_;  // kRuns: classify_rows()'s output for the window
   cv::Rect window_;
   cv::Point mask_origin_;
   int32_t next_ = 1;

@@ -45,7 +45,7 @@ cv::Point2d pixel(const CameraModel& camera, const Eigen::Vector3d& world) {
 // The segmenter keeps the largest regions largest first, with their extent, colour and mask.
 TEST(Segmenter, CandidatesLargestFirstWithBoxColourAndMask) {
   cv::Mat image = grey_image();
-  cv::rectangle(image, cv::Rect(10, 20, 30, 10), kRed, cv::FILLED);   // 300 px
+  cv::rectangle(image, cv::Rect(10, 20, 30, 10), kRed, cv::FILLED);    // 300 px
   cv::rectangle(image, cv::Rect(100, 100, 20, 20), kRed, cv::FILLED);  // 400 px
   cv::rectangle(image, cv::Rect(300, 300, 5, 5), kRed, cv::FILLED);    // 25 px, under min_area
   Segmenter segmenter(image.size());

@@ -3,13 +3,12 @@
 
 #include <gtest/gtest.h>
 
-#include "tests/support/allocation_counter.hpp"
-
 #include <atomic>
 #include <cstdlib>
 #include <new>
 #include <opencv2/imgproc.hpp>
 
+#include "tests/support/allocation_counter.hpp"
 #include "vision/blob_tracker.hpp"
 #include "vision/vision_config.hpp"
 

@@ -4,7 +4,6 @@
 // the same regions, in the same order, with the same moments, extent, colour and masks.
 
 #include <gtest/gtest.h>
-
 #include <hwy/targets.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -56,8 +55,8 @@ TEST(ColorKernels, ClassifyIsIsObjectForEveryColour) {
         objects += is;
         wrong += bit(bits, i) != is;
       }
-      EXPECT_EQ(wrong, 0u) << hwy::TargetName(target) << ", r " << t.r_min << "-" << t.r_max
-                           << ", " << objects << " objects";
+      EXPECT_EQ(wrong, 0u) << hwy::TargetName(target) << ", r " << t.r_min << "-" << t.r_max << ", "
+                           << objects << " objects";
     }
   }
   hwy::SetSupportedTargetsForTest(0);
