@@ -4,7 +4,8 @@
 /// normalized RGB (eq. 7) is cut to the central pixels of confidently found, fully visible ball
 /// images, and follows a lighting drift — within the configured ranges, never beyond them.
 ///
-/// For each band (r, g, b) the pixels within `inner` radii of the ball's centre give the
+/// For each band (r, g, b) the pixels within `inner` radii of the ball's centre (on a square grid
+/// of about 150 of them, whatever the ball's size) give the
 /// `quantile` and 1 - `quantile` values q_lo, q_hi of one frame; their exponentially weighted
 /// averages (weight `rate`) L, H give the band
 ///
@@ -62,8 +63,11 @@ class ColorAdaptation {
 
   ColorThresholds configured_, current_;
   ColorAdaptationParams p_;
-  std::array<std::vector<float>, 3> pixels_;  // r, g, b of one frame's sampled pixels
-  std::array<double, 3> low_{}, high_{};      // L, H per band
+  // r, g, b of one frame's `count_` sampled pixels (first R, G, B, then divided by sum_)
+  std::array<std::vector<float>, 3> pixels_;
+  std::vector<float> sum_;  // R+G+B of each sampled pixel
+  size_t count_ = 0;
+  std::array<double, 3> low_{}, high_{};  // L, H per band
   int samples_ = 0;
 };
 

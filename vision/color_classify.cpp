@@ -1,7 +1,7 @@
 // ColorDetector::classify: the colour test of a row of pixels in SIMD lanes (Highway), compiled
 // once per instruction set (SSE4, AVX2, AVX-512, ...) and chosen when first called.
 //
-// Each of the six bounds of eq. 8 is a test X <= floor(q S / 2^16) of an integer X against the
+// Each of the six bounds of eq. 8 is a test X <= floor(q S / 2^15) of an integer X against the
 // high half of a 16-bit product (color_detector.hpp says why that is exactly is_object()), so a
 // pixel costs 16-bit adds, six MulHigh and six compares: 16 pixels a vector with AVX2, 32 with
 // AVX-512.
@@ -21,24 +21,24 @@ namespace sg::vision {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-/// Bits of `ok` for lanes [0, count) into `bits` at bit `at` (the words were zeroed).
+/// The bits of `ok`'s lanes, lane i at bit i.
 template <class D, class M>
-HWY_INLINE void put_bits(D d, M ok, size_t at, uint64_t* HWY_RESTRICT bits) {
+HWY_INLINE uint64_t mask_bits(D d, M ok) {
   uint8_t bytes[8] = {};
   hn::StoreMaskBits(d, ok, bytes);
   uint64_t word;
   std::memcpy(&word, bytes, sizeof word);
-  bits[at / 64] |= word << (at % 64);  // lanes are a power of two up to 64: never straddles
+  return word;
 }
 
 /// One vector of pixels: the mask of those of the object's colour.
 template <class D16, class V>
 HWY_INLINE auto object_lanes(D16 d16, V b, V g, V r, const ColorBounds& k) {
   const hn::RebindToSigned<D16> di;
-  const V s = hn::Add(hn::Add(b, g), r);
+  const V s = hn::Add(hn::Add(b, g), r), twice_s = hn::Add(s, s);
   // X in lanes as signed (all values <= 765): Gt is signed on x86 before AVX-512.
   auto over = [&](V x, int i) {
-    const V bound = hn::Or(hn::MulHigh(s, hn::Set(d16, k.q[i])), hn::Set(d16, k.always[i]));
+    const V bound = hn::MulHigh(twice_s, hn::Set(d16, k.q[i]));  // floor(q S / 2^15)
     return hn::Gt(hn::BitCast(di, x), hn::BitCast(di, bound));
   };
   auto fail = hn::Lt(hn::BitCast(di, s), hn::Set(di, k.min_sum));
@@ -51,41 +51,79 @@ HWY_INLINE auto object_lanes(D16 d16, V b, V g, V r, const ColorBounds& k) {
   return hn::RebindMask(d16, hn::Not(fail));
 }
 
-/// One row: bits[i / 64] bit i % 64 for pixel i < n (the words were zeroed); pixels up to
-/// `readable` may be read.
-template <class D16>
-HWY_INLINE void classify_row(D16 d16, const uint8_t* HWY_RESTRICT bgr, size_t n, size_t readable,
+/// One vector of bytes' worth of pixels from `bgr` (Lanes(d8), at most 64): pixel i's test at
+/// bit i. The bytes are loaded whole, each half widened to 16-bit lanes.
+template <class D8>
+HWY_INLINE uint64_t classify_step(D8 d8, const uint8_t* HWY_RESTRICT bgr, const ColorBounds& k) {
+  hn::Vec<D8> b, g, r;
+  hn::LoadInterleaved3(d8, bgr, b, g, r);
+#if HWY_TARGET == HWY_SCALAR  // one lane: no halves
+  const hn::Rebind<uint16_t, D8> d16;
+  return mask_bits(d16, object_lanes(d16, hn::PromoteTo(d16, b), hn::PromoteTo(d16, g),
+                                     hn::PromoteTo(d16, r), k));
+#else
+  const hn::Half<D8> dh;
+  const hn::Rebind<uint16_t, decltype(dh)> d16;
+  const auto lower = object_lanes(d16, hn::PromoteTo(d16, hn::LowerHalf(dh, b)),
+                                  hn::PromoteTo(d16, hn::LowerHalf(dh, g)),
+                                  hn::PromoteTo(d16, hn::LowerHalf(dh, r)), k);
+  const auto upper = object_lanes(d16, hn::PromoteTo(d16, hn::UpperHalf(dh, b)),
+                                  hn::PromoteTo(d16, hn::UpperHalf(dh, g)),
+                                  hn::PromoteTo(d16, hn::UpperHalf(dh, r)), k);
+  return mask_bits(d16, lower) | mask_bits(d16, upper) << hn::Lanes(d16);
+#endif
+}
+
+#if HWY_TARGET == HWY_SCALAR
+template <class D8>
+D8 half_of(D8 d8) {
+  return d8;
+}
+#else
+/// A vector of half as many bytes, for a row's last pixels.
+template <class D8>
+hn::Half<D8> half_of(D8) {
+  return {};
+}
+#endif
+
+/// One row: bits[i / 64] bit i % 64 for pixel i < n, the last word's bits past n zero; pixels up
+/// to `readable` may be read. Whole vectors of bytes, then the last pixels in half a vector (a
+/// 64-pixel step, say, then 32: an 82-pixel row costs 96 pixels' work, not 128).
+template <class D8>
+HWY_INLINE void classify_row(D8 d8, const uint8_t* HWY_RESTRICT bgr, size_t n, size_t readable,
                              uint64_t* HWY_RESTRICT bits, const ColorBounds& k) {
-  const hn::Rebind<uint8_t, D16> d8;
-  const size_t lanes = hn::Lanes(d16);
-  hn::Vec<decltype(d8)> b8, g8, r8;
+  const auto dh = half_of(d8);
+  const size_t lanes = hn::Lanes(d8), half = hn::Lanes(dh);  // powers of two up to 64
+  uint64_t word = 0;
   size_t i = 0;
   for (; i + lanes <= n; i += lanes) {
-    hn::LoadInterleaved3(d8, bgr + 3 * i, b8, g8, r8);
-    const auto ok = object_lanes(d16, hn::PromoteTo(d16, b8), hn::PromoteTo(d16, g8),
-                                 hn::PromoteTo(d16, r8), k);
-    put_bits(d16, ok, i, bits);
+    word |= classify_step(d8, bgr + 3 * i, k) << (i % 64);
+    if ((i + lanes) % 64 == 0) bits[i / 64] = word, word = 0;
   }
-  if (i == n) return;
-  // The last pixels: read in place when a whole vector may be, else through a zeroed copy (a
-  // black pixel is below any min_sum, which is at least 1); lanes past n masked off.
-  alignas(64) uint8_t tail[3 * 64] = {};
-  const uint8_t* last = bgr + 3 * i;
-  if (i + lanes > readable)
-    last = static_cast<const uint8_t*>(std::memcpy(tail, last, 3 * (n - i)));
-  hn::LoadInterleaved3(d8, last, b8, g8, r8);
-  const auto ok =
-      object_lanes(d16, hn::PromoteTo(d16, b8), hn::PromoteTo(d16, g8), hn::PromoteTo(d16, r8), k);
-  put_bits(d16, hn::And(ok, hn::FirstN(d16, n - i)), i, bits);
+  if (half < lanes && i + half <= n) {  // i % 64 + half < 64: no word fills
+    word |= classify_step(dh, bgr + 3 * i, k) << (i % 64);
+    i += half;
+  }
+  if (i < n) {
+    // Fewer than `half` pixels: read in place when a whole half vector may be, else through a
+    // zeroed copy; bits past n cleared.
+    alignas(64) uint8_t tail[3 * 64] = {};
+    const uint8_t* last = bgr + 3 * i;
+    if (i + half > readable) {
+      last = static_cast<const uint8_t*>(std::memcpy(tail, last, 3 * (n - i)));
+    }
+    const uint64_t valid = ~uint64_t{0} >> (64 - (n - i));
+    word |= (classify_step(dh, last, k) & valid) << (i % 64);
+    i = n;
+  }
+  if (i % 64 != 0) bits[i / 64] = word;
 }
 
 void ClassifyRows(const ClassifyRowsArgs& a, const ColorBounds& k) {
-  const hn::ScalableTag<uint16_t> d16;
-  const size_t words = (a.width + 63) / 64;
+  const hn::ScalableTag<uint8_t> d8;
   for (size_t y = 0; y < a.height; ++y) {
-    uint64_t* bits = a.bits + y * a.words_per_row;
-    std::memset(bits, 0, words * sizeof(uint64_t));
-    classify_row(d16, a.bgr + y * a.stride, a.width, a.readable, bits, k);
+    classify_row(d8, a.bgr + y * a.stride, a.width, a.readable, a.bits + y * a.words_per_row, k);
   }
 }
 

@@ -8,13 +8,10 @@
 namespace sg::vision {
 namespace {
 
-int64_t fixed(double v) { return std::llround(std::clamp(v, 0.0, 1.0) * 65536.0); }
+int64_t fixed(double v) { return std::llround(std::clamp(v, 0.0, 1.0) * 32768.0); }
 
-/// ColorBounds's q for a bound of 2^16 q_fixed: 2^16 itself is `always`.
-void set_bound(ColorBounds& k, int i, int64_t q) {
-  k.q[i] = static_cast<uint16_t>(q & 0xffff);
-  k.always[i] = q >= 65536 ? 0x7fff : 0;
-}
+/// ColorBounds's q for a bound X <= q S / 2^15 (0 <= q <= 2^15).
+void set_bound(ColorBounds& k, int i, int64_t q) { k.q[i] = static_cast<uint16_t>(q); }
 
 }  // namespace
 

@@ -23,15 +23,14 @@ struct ColorThresholds {
 };
 
 /// ColorDetector's bounds as classify()'s SIMD lanes use them. Each bound of eq. 8 is
-/// X <= floor(q S / 2^16), S = B+G+R, X an integer: an upper bound r <= r_max is X = R with
-/// q = round(2^16 r_max); a lower one, r >= r_min, is the same as (G+B) 2^16 <= (2^16 - q_min) S,
-/// so X = G+B with q = 2^16 - round(2^16 r_min). floor(q S / 2^16) is the high half of a 16-bit
-/// product; q = 2^16 (a bound that always holds: X <= S) is q = 0 with `always` set instead.
-/// Order: R, G+B, G, R+B, B, R+G.
+/// X <= floor(q S / 2^15), S = B+G+R, X an integer: an upper bound r <= r_max is X = R with
+/// q = round(2^15 r_max); a lower one, r >= r_min, is the same as (G+B) 2^15 <= (2^15 - q_min) S,
+/// so X = G+B with q = 2^15 - round(2^15 r_min). With S < 2^10 and q <= 2^15 (a bound that
+/// always holds included), floor(q S / 2^15) = floor(q (2 S) / 2^16) is the high half of one
+/// unsigned 16-bit product. Order: R, G+B, G, R+B, B, R+G.
 struct ColorBounds {
   uint16_t q[6] = {};
-  uint16_t always[6] = {};  ///< 0x7fff where the bound always holds, else 0
-  int16_t min_sum = 1;      ///< R+G+B below it fails (at most 766: never)
+  int16_t min_sum = 1;  ///< R+G+B below it fails (at most 766: never)
 };
 
 /// A block of rows for ColorDetector::classify_rows: `height` rows of `width` BGR pixels,
@@ -45,7 +44,7 @@ struct ClassifyRowsArgs {
 };
 
 /// The paper's threshold (eq. 8) on normalized RGB (eq. 7), in integer arithmetic with no
-/// division: r >= r_min  <=>  2^16 R >= round(2^16 r_min) (R+G+B).
+/// division: r >= r_min  <=>  2^15 R >= round(2^15 r_min) (R+G+B) (thresholds to 2^-15, 3e-5).
 ///
 ///     ColorDetector red(thresholds);
 ///     if (red.is_object(pixel)) ...     // pixel: const uint8_t* B, G, R
@@ -65,7 +64,8 @@ class ColorDetector {
 
   /// is_object() of `n` pixels at once, as bits: bit i % 64 of bits[i / 64] is set for the
   /// object's colour; the ceil(n / 64) words are all written (bits past n clear). The bounds as
-  /// ColorBounds in 16-bit SIMD lanes (Highway: SSE4, AVX2 or AVX-512, whichever the CPU has),
+  /// ColorBounds in 16-bit SIMD lanes (Highway: SSE4, AVX2 or AVX-512, whichever the CPU has; a
+  /// vector of bytes loaded at a time, each half widened),
   /// bit for bit is_object() (a test, over every colour and every compiled instruction set).
   /// `readable`: pixels that may be read from `bgr` (at least n; the rest of an image's row), so
   /// the last vector is read in place rather than copied.
@@ -76,7 +76,7 @@ class ColorDetector {
   const ColorThresholds& thresholds() const { return t_; }
 
  private:
-  static constexpr int64_t kOne = 1 << 16;
+  static constexpr int64_t kOne = 1 << 15;
   ColorThresholds t_;
   int64_t r_lo_, r_hi_, g_lo_, g_hi_, b_lo_, b_hi_, min_sum_;
   ColorBounds bounds_;

@@ -45,7 +45,7 @@ size_t first_beyond(const float* v, size_t from, size_t n, float bound, bool lar
   return HWY_DYNAMIC_DISPATCH(FirstBeyond)(v, from, n, bound, largest);
 }
 
-float order_statistic(std::vector<float>& v, size_t k, bool largest) {
+float order_statistic(std::span<float> v, size_t k, bool largest) {
   constexpr size_t kSmall = 16;
   auto before = [largest](float a, float b) { return largest ? a > b : a < b; };
   if (k >= kSmall) {
@@ -67,7 +67,7 @@ float order_statistic(std::vector<float>& v, size_t k, bool largest) {
   return best[k];
 }
 
-float quantile_of(std::vector<float>& v, double q) {
+float quantile_of(std::span<float> v, double q) {
   const auto k = static_cast<size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
   if (k <= v.size() / 2) return order_statistic(v, k, false);
   return order_statistic(v, v.size() - 1 - k, true);

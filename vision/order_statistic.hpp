@@ -1,7 +1,7 @@
 #pragma once
 
 #include <cstddef>
-#include <vector>
+#include <span>
 
 namespace sg::vision {
 
@@ -15,12 +15,12 @@ size_t first_beyond(const float* v, size_t from, size_t n, float bound, bool lar
 /// them, a vector of values a compare. A large k uses nth_element (and reorders v). Either way
 /// the exact order statistic.
 ///
-///     std::vector<float> r = ...;
+///     std::vector<float> r = ...;  // or any std::span<float>
 ///     float third_smallest = order_statistic(r, 2, false);
-float order_statistic(std::vector<float>& v, size_t k, bool largest);
+float order_statistic(std::span<float> v, size_t k, bool largest);
 
 /// The q-quantile (0 <= q <= 1) of a non-empty `v`: its round(q (n - 1))-th smallest, found from
 /// whichever end is nearer (the k-th smallest is the (n - 1 - k)-th largest).
-float quantile_of(std::vector<float>& v, double q);
+float quantile_of(std::span<float> v, double q);
 
 }  // namespace sg::vision

@@ -4,11 +4,11 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "vision/channel_sums.hpp"
+
 namespace sg::vision {
 
 Segmenter::Segmenter(cv::Size max_size, Kernel kernel) : max_size_(max_size), kernel_(kernel) {
-  if (max_size.width < 0 || max_size.height < 0 || max_size.width >= (1 << 24))
-    throw std::invalid_argument("Segmenter: image size out of range");
   const size_t pixels = static_cast<size_t>(max_size.area());
   const size_t rows = static_cast<size_t>(max_size.height);
   // 8-connectivity: at most one new label (one run) every other pixel, half a pixel more a row
@@ -114,8 +114,9 @@ int next_where(const uint64_t* bits, int x, int n, bool set) {
 /// Sum of k^2 for k in [0, x].
 int64_t squares_to(int64_t x) { return x * (x + 1) * (2 * x + 1) / 6; }
 
-/// A run's pixels [xa, xb] of image row y: moments in closed form, extent, colour.
-void add_run(Region& r, int64_t xa, int64_t xb, int64_t y, const uint8_t* bgr) {
+/// A run's pixels [xa, xb] of image row y: moments in closed form, extent, colour (`bgr` the
+/// run's first pixel, `readable` pixels from it in the row).
+void add_run(Region& r, int64_t xa, int64_t xb, int64_t y, const uint8_t* bgr, int readable) {
   const int64_t n = xb - xa + 1, sum_x = (xa + xb) * n / 2;
   RawMoments& m = r.moments;
   m.m00 += n, m.m10 += sum_x, m.m01 += n * y;
@@ -123,9 +124,10 @@ void add_run(Region& r, int64_t xa, int64_t xb, int64_t y, const uint8_t* bgr) {
   r.x_min = std::min(r.x_min, static_cast<int>(xa)),
   r.x_max = std::max(r.x_max, static_cast<int>(xb));
   r.y_max = static_cast<int>(y);
-  uint32_t b = 0, g = 0, red = 0;  // a run is under 2^24 px (the constructor): no overflow
-  for (int64_t i = 0; i < 3 * n; i += 3) b += bgr[i], g += bgr[i + 1], red += bgr[i + 2];
-  r.sum_b += b, r.sum_g += g, r.sum_r += red;
+  const auto [b, g, red] =
+      channel_sums(bgr, static_cast<size_t>(n), static_cast<size_t>(std::max(0, readable)));
+  r.sum_b += static_cast<int64_t>(b), r.sum_g += static_cast<int64_t>(g);
+  r.sum_r += static_cast<int64_t>(red);
 }
 
 }  // namespace
@@ -167,7 +169,8 @@ void Segmenter::label_runs(const cv::Mat& bgr, const ColorDetector& detector) {
             Region{{}, w.x + x0, w.y + y, w.x + x0, w.y + y, 0, 0, 0, label};
       }
       runs_[count++] = {x0, x1, label};
-      add_run(sums_[static_cast<size_t>(label)], w.x + x0, w.x + x1 - 1, w.y + y, in + 3 * x0);
+      add_run(sums_[static_cast<size_t>(label)], w.x + x0, w.x + x1 - 1, w.y + y, in + 3 * x0,
+              bgr.cols - w.x - x0);
       x0 = x1;
     }
   }
