@@ -88,8 +88,8 @@ hn::Half<D8> half_of(D8) {
 #endif
 
 /// One row: bits[i / 64] bit i % 64 for pixel i < n, the last word's bits past n zero; pixels up
-/// to `readable` may be read. Whole vectors of bytes, then the last pixels in half a vector (a
-/// 64-pixel step, say, then 32: an 82-pixel row costs 96 pixels' work, not 128).
+/// to `readable` may be read. Whole vectors of bytes; the last pixels in one more where it may be
+/// read in place (at a row's end: half a vector, then the rest through a copy).
 template <class D8>
 HWY_INLINE void classify_row(D8 d8, const uint8_t* HWY_RESTRICT bgr, size_t n, size_t readable,
                              uint64_t* HWY_RESTRICT bits, const ColorBounds& k) {
@@ -100,6 +100,11 @@ HWY_INLINE void classify_row(D8 d8, const uint8_t* HWY_RESTRICT bgr, size_t n, s
   for (; i + lanes <= n; i += lanes) {
     word |= classify_step(d8, bgr + 3 * i, k) << (i % 64);
     if ((i + lanes) % 64 == 0) bits[i / 64] = word, word = 0;
+  }
+  if (i < n && i + lanes <= readable) {  // the last pixels in place, in a whole vector
+    const uint64_t valid = ~uint64_t{0} >> (64 - (n - i));
+    word |= (classify_step(d8, bgr + 3 * i, k) & valid) << (i % 64);
+    i = n;
   }
   if (half < lanes && i + half <= n) {  // i % 64 + half < 64: no word fills
     word |= classify_step(dh, bgr + 3 * i, k) << (i % 64);
