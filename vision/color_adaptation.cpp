@@ -76,8 +76,9 @@ bool ColorAdaptation::learn(const cv::Mat& bgr, const cv::Point2d& centre, doubl
   const double a = samples_ == 0 ? 1.0 : std::max(p_.rate, 1.0 / (samples_ + 1));
   for (size_t b = 0; b < 3; ++b) {
     const std::span<float> band(pixels_[b].data(), count_);
-    low_[b] += a * (quantile_of(band, p_.quantile) - low_[b]);
-    high_[b] += a * (quantile_of(band, 1 - p_.quantile) - high_[b]);
+    const auto [q_lo, q_hi] = quantiles_of(band, p_.quantile);
+    low_[b] += a * (q_lo - low_[b]);
+    high_[b] += a * (q_hi - high_[b]);
   }
   ++samples_;
   if (samples_ < p_.min_samples) return false;

@@ -4,6 +4,7 @@
 #include "vision/order_statistic.hpp"
 
 #include <gtest/gtest.h>
+#include <hwy/targets.h>
 
 #include <random>
 
@@ -49,6 +50,38 @@ TEST(OrderStatistic, QuantileIsTheSortedCopys) {
       EXPECT_EQ(quantile_of(a, q), sorted[k]) << "n " << n << ", q " << q;
     }
   }
+}
+
+/// quantiles_of(a copy of v, q) against the sorted copy, for q near an end and q = 0.1, v of
+/// every length up to 70 and some to 400, with few and with many distinct values.
+void expect_quantiles_sorted() {
+  std::mt19937 rng(9);
+  for (size_t n = 1; n <= 400; n += (n < 70 ? 1 : 11)) {
+    for (const int distinct : {2, 50, 1000000}) {
+      const std::vector<float> v = values(n, distinct, rng);
+      std::vector<float> sorted = v;
+      std::sort(sorted.begin(), sorted.end());
+      for (const double q : {0.0, 0.01, 0.02, 0.05, 0.1}) {
+        std::vector<float> a = v;
+        const auto [lo, hi] = quantiles_of(a, q);
+        const auto k = static_cast<size_t>(q * static_cast<double>(n - 1) + 0.5);
+        const auto k_hi = static_cast<size_t>((1 - q) * static_cast<double>(n - 1) + 0.5);
+        ASSERT_EQ(lo, sorted[k]) << "n " << n << ", q " << q;
+        ASSERT_EQ(hi, sorted[k_hi]) << "n " << n << ", q " << q;
+      }
+    }
+  }
+}
+
+// quantiles_of(v, q) is both ends' quantile_of, with every compiled instruction set: on the lane
+// path (q near an end: every length around the vector sizes, up to the largest kept set) and off
+// it (q = 0.1 of 300 values).
+TEST(OrderStatistic, QuantilesAreTheSortedCopys) {
+  for (const int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    expect_quantiles_sorted();
+  }
+  hwy::SetSupportedTargetsForTest(0);
 }
 
 }  // namespace
