@@ -16,41 +16,55 @@ namespace sg::vision {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-std::array<uint64_t, 3> ChannelSums(const uint8_t* HWY_RESTRICT bgr, size_t n, size_t readable) {
-#if HWY_TARGET == HWY_SCALAR  // one lane: no groups of eight
-  (void)readable;
-  std::array<uint64_t, 3> s{};
-  for (size_t i = 0; i < 3 * n; i += 3) s[0] += bgr[i], s[1] += bgr[i + 1], s[2] += bgr[i + 2];
-  return s;
-#else
-  const hn::ScalableTag<uint8_t> d8;
-  const hn::Repartition<uint64_t, decltype(d8)> d64;
+#if HWY_TARGET != HWY_SCALAR
+/// Sums of up to 4095 pixels: per 64-bit lane, B + 2^20 G + 2^40 R of groups of eight (each
+/// field under 255 * 4095 < 2^20), so one reduction gives all three.
+template <class D8>
+HWY_INLINE uint64_t PackedSums(D8 d8, const uint8_t* HWY_RESTRICT bgr, size_t n, size_t readable) {
+  const hn::Repartition<uint64_t, D8> d64;
   const size_t lanes = hn::Lanes(d8);
-  auto sb = hn::Zero(d64), sg = hn::Zero(d64), sr = hn::Zero(d64);
-  hn::Vec<decltype(d8)> b, g, r;
+  auto packed = hn::Zero(d64);
+  auto add = [&](auto b, auto g, auto r) {
+    packed = hn::Add(packed, hn::SumsOf8(b));
+    packed = hn::Add(packed, hn::ShiftLeft<20>(hn::SumsOf8(g)));
+    packed = hn::Add(packed, hn::ShiftLeft<40>(hn::SumsOf8(r)));
+  };
+  hn::Vec<D8> b, g, r;
   size_t i = 0;
   for (; i + lanes <= n; i += lanes) {
     hn::LoadInterleaved3(d8, bgr + 3 * i, b, g, r);
-    sb = hn::Add(sb, hn::SumsOf8(b)), sg = hn::Add(sg, hn::SumsOf8(g));
-    sr = hn::Add(sr, hn::SumsOf8(r));
+    add(b, g, r);
   }
   if (i < n) {
     // The last pixels: in place when a whole vector may be read, else through a copy; lanes past
     // n zeroed.
-    alignas(64) uint8_t tail[3 * 64 * 4] = {};  // lanes <= 256 (any Highway target's u8 vector)
+    alignas(64) uint8_t tail[3 * 256] = {};  // lanes <= 256 (any Highway target's u8 vector)
     const uint8_t* last = bgr + 3 * i;
     if (i + lanes > readable || lanes > 256) {
       last = static_cast<const uint8_t*>(std::memcpy(tail, last, 3 * (n - i)));
     }
     hn::LoadInterleaved3(d8, last, b, g, r);
     const auto valid = hn::FirstN(d8, n - i);
-    sb = hn::Add(sb, hn::SumsOf8(hn::IfThenElseZero(valid, b)));
-    sg = hn::Add(sg, hn::SumsOf8(hn::IfThenElseZero(valid, g)));
-    sr = hn::Add(sr, hn::SumsOf8(hn::IfThenElseZero(valid, r)));
+    add(hn::IfThenElseZero(valid, b), hn::IfThenElseZero(valid, g), hn::IfThenElseZero(valid, r));
   }
-  return {hn::GetLane(hn::SumOfLanes(d64, sb)), hn::GetLane(hn::SumOfLanes(d64, sg)),
-          hn::GetLane(hn::SumOfLanes(d64, sr))};
+  return hn::GetLane(hn::SumOfLanes(d64, packed));
+}
 #endif
+
+std::array<uint64_t, 3> ChannelSums(const uint8_t* HWY_RESTRICT bgr, size_t n, size_t readable) {
+  std::array<uint64_t, 3> s{};
+#if HWY_TARGET == HWY_SCALAR  // one lane: no groups of eight
+  (void)readable;
+  for (size_t i = 0; i < 3 * n; i += 3) s[0] += bgr[i], s[1] += bgr[i + 1], s[2] += bgr[i + 2];
+#else
+  constexpr size_t kChunk = 4095;  // pixels whose sums fit PackedSums's fields
+  const hn::ScalableTag<uint8_t> d8;
+  for (size_t i = 0; i < n; i += kChunk) {
+    const uint64_t p = PackedSums(d8, bgr + 3 * i, std::min(kChunk, n - i), readable - i);
+    s[0] += p & 0xfffff, s[1] += (p >> 20) & 0xfffff, s[2] += p >> 40;
+  }
+#endif
+  return s;
 }
 
 }  // namespace HWY_NAMESPACE

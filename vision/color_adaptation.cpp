@@ -52,21 +52,24 @@ bool ColorAdaptation::sample(const cv::Mat& bgr, const cv::Point2d& centre, doub
   const int x0 = std::max(0, static_cast<int>(std::ceil(centre.x - reach)));
   const int x1 = std::min(bgr.cols - 1, static_cast<int>(std::floor(centre.x + reach)));
   const int min_sum = std::max(1, configured_.min_intensity);  // a black pixel has no colour
+  // Locals, not members, in the loops: a store through a float* may not change them.
+  float *r = pixels_[0].data(), *g = pixels_[1].data(), *b = pixels_[2].data();
+  float* sum = sum_.data();
+  size_t n = 0;
   for (int y = y0; y <= y1; y += step) {
     const auto* row = bgr.ptr<uint8_t>(y);
-    for (int x = x0; x <= x1 && count_ < kMaxPixels; x += step) {
-      const double dx = x - centre.x, dy = y - centre.y;
+    const double dy = y - centre.y, dx_max2 = reach2 - dy * dy;
+    for (int x = x0; x <= x1 && n < kMaxPixels; x += step) {
+      const double dx = x - centre.x;
       const uint8_t* px = row + 3 * x;
-      const int sum = px[0] + px[1] + px[2];
-      if (dx * dx + dy * dy > reach2 || sum < min_sum) continue;
-      pixels_[0][count_] = px[2], pixels_[1][count_] = px[1], pixels_[2][count_] = px[0];
-      sum_[count_++] = static_cast<float>(sum);
+      const int s = px[0] + px[1] + px[2];
+      if (dx * dx > dx_max2 || s < min_sum) continue;
+      r[n] = px[2], g[n] = px[1], b[n] = px[0], sum[n++] = static_cast<float>(s);
     }
   }
   // Then the chromaticities, a loop the compiler vectorizes (exact: IEEE division in each lane).
-  for (auto& band : pixels_) {
-    for (size_t i = 0; i < count_; ++i) band[i] /= sum_[i];
-  }
+  for (size_t i = 0; i < n; ++i) r[i] /= sum[i], g[i] /= sum[i], b[i] /= sum[i];
+  count_ = n;
   // Never an empty sample, whatever min_pixels says: quantile_of needs a pixel.
   return count_ > 0 && static_cast<int>(count_) >= p_.min_pixels;
 }

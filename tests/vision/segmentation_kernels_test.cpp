@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <hwy/targets.h>
 
+#include <numeric>
 #include <opencv2/imgcodecs.hpp>
 #include <random>
 #include <string>
@@ -13,6 +14,7 @@
 
 #include "sim/camera_simulator.hpp"
 #include "sim/real_scene.hpp"
+#include "vision/channel_sums.hpp"
 #include "vision/color_detector.hpp"
 #include "vision/segmentation.hpp"
 
@@ -81,6 +83,31 @@ TEST(ColorKernels, ClassifyEveryRowLength) {
           ASSERT_EQ(bit(bits, i), want) << hwy::TargetName(target) << ", n " << n << ", readable "
                                         << readable << ", pixel " << i;
         }
+      }
+    }
+  }
+  hwy::SetSupportedTargetsForTest(0);
+}
+
+// channel_sums() of every run length to 200 and of 10000 pixels (more than one packed chunk),
+// read in place and through the copy, with every compiled instruction set: a plain loop's sums.
+TEST(ColorKernels, ChannelSumsOfEveryRunLength) {
+  std::mt19937 rng(23);
+  std::vector<uint8_t> bgr(3 * 10400);
+  for (uint8_t& v : bgr) v = static_cast<uint8_t>(rng());
+  std::vector<size_t> lengths(200);
+  std::iota(lengths.begin(), lengths.end(), 1);
+  lengths.push_back(10000);
+  for (const int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    for (const size_t n : lengths) {
+      std::array<uint64_t, 3> want{};
+      for (size_t i = 0; i < n; ++i) {
+        for (size_t c = 0; c < 3; ++c) want[c] += bgr[3 * i + c];
+      }
+      for (const size_t readable : {n, size_t{10400}}) {
+        ASSERT_EQ(channel_sums(bgr.data(), n, readable), want)
+            << hwy::TargetName(target) << ", n " << n << ", readable " << readable;
       }
     }
   }
