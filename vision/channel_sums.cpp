@@ -36,11 +36,12 @@ HWY_INLINE uint64_t PackedSums(D8 d8, const uint8_t* HWY_RESTRICT bgr, size_t n,
     add(b, g, r);
   }
   if (i < n) {
-    // The last pixels: in place when a whole vector may be read, else through a copy; lanes past
-    // n zeroed.
-    alignas(64) uint8_t tail[3 * 256] = {};  // lanes <= 256 (any Highway target's u8 vector)
+    // The last pixels: in place when a whole vector may be read, else through a copy (zeroed
+    // only then: the hot path is a short run in place); lanes past n zeroed.
+    alignas(64) uint8_t tail[3 * HWY_MAX_BYTES];
     const uint8_t* last = bgr + 3 * i;
-    if (i + lanes > readable || lanes > 256) {
+    if (i + lanes > readable) {
+      std::memset(tail, 0, sizeof tail);
       last = static_cast<const uint8_t*>(std::memcpy(tail, last, 3 * (n - i)));
     }
     hn::LoadInterleaved3(d8, last, b, g, r);
@@ -51,20 +52,20 @@ HWY_INLINE uint64_t PackedSums(D8 d8, const uint8_t* HWY_RESTRICT bgr, size_t n,
 }
 #endif
 
-std::array<uint64_t, 3> ChannelSums(const uint8_t* HWY_RESTRICT bgr, size_t n, size_t readable) {
-  std::array<uint64_t, 3> s{};
+void AddChannelSums(const uint8_t* HWY_RESTRICT bgr, size_t n, size_t readable,
+                    int64_t* HWY_RESTRICT b, int64_t* HWY_RESTRICT g, int64_t* HWY_RESTRICT r) {
 #if HWY_TARGET == HWY_SCALAR  // one lane: no groups of eight
   (void)readable;
-  for (size_t i = 0; i < 3 * n; i += 3) s[0] += bgr[i], s[1] += bgr[i + 1], s[2] += bgr[i + 2];
+  for (size_t i = 0; i < 3 * n; i += 3) *b += bgr[i], *g += bgr[i + 1], *r += bgr[i + 2];
 #else
   constexpr size_t kChunk = 4095;  // pixels whose sums fit PackedSums's fields
   const hn::ScalableTag<uint8_t> d8;
   for (size_t i = 0; i < n; i += kChunk) {
     const uint64_t p = PackedSums(d8, bgr + 3 * i, std::min(kChunk, n - i), readable - i);
-    s[0] += p & 0xfffff, s[1] += (p >> 20) & 0xfffff, s[2] += p >> 40;
+    *b += static_cast<int64_t>(p & 0xfffff), *g += static_cast<int64_t>((p >> 20) & 0xfffff);
+    *r += static_cast<int64_t>(p >> 40);
   }
 #endif
-  return s;
 }
 
 }  // namespace HWY_NAMESPACE
@@ -74,11 +75,18 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace sg::vision {
 
-HWY_EXPORT(ChannelSums);
+HWY_EXPORT(AddChannelSums);
+
+void add_channel_sums(const uint8_t* bgr, size_t n, size_t readable, int64_t* b, int64_t* g,
+                      int64_t* r) {
+  if (n == 0) return;
+  HWY_DYNAMIC_DISPATCH(AddChannelSums)(bgr, n, std::max(n, readable), b, g, r);
+}
 
 std::array<uint64_t, 3> channel_sums(const uint8_t* bgr, size_t n, size_t readable) {
-  if (n == 0) return {};
-  return HWY_DYNAMIC_DISPATCH(ChannelSums)(bgr, n, std::max(n, readable));
+  int64_t b = 0, g = 0, r = 0;
+  add_channel_sums(bgr, n, readable, &b, &g, &r);
+  return {static_cast<uint64_t>(b), static_cast<uint64_t>(g), static_cast<uint64_t>(r)};
 }
 
 }  // namespace sg::vision

@@ -14,4 +14,9 @@ namespace sg::vision {
 ///     const auto [b, g, r] = channel_sums(row + 3 * x0, x1 - x0, image.cols - x0);
 std::array<uint64_t, 3> channel_sums(const uint8_t* bgr, size_t n, size_t readable);
 
+/// channel_sums() added to *b, *g, *r (no array returned through memory for the caller to load
+/// back: the hot path of run labelling).
+void add_channel_sums(const uint8_t* bgr, size_t n, size_t readable, int64_t* b, int64_t* g,
+                      int64_t* r);
+
 }  // namespace sg::vision

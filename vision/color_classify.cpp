@@ -113,9 +113,10 @@ HWY_INLINE void classify_row(D8 d8, const uint8_t* HWY_RESTRICT bgr, size_t n, s
   if (i < n) {
     // Fewer than `half` pixels: read in place when a whole half vector may be, else through a
     // zeroed copy; bits past n cleared.
-    alignas(64) uint8_t tail[3 * 64] = {};
+    alignas(64) uint8_t tail[3 * 64];
     const uint8_t* last = bgr + 3 * i;
     if (i + half > readable) {
+      std::memset(tail, 0, sizeof tail);
       last = static_cast<const uint8_t*>(std::memcpy(tail, last, 3 * (n - i)));
     }
     const uint64_t valid = ~uint64_t{0} >> (64 - (n - i));

@@ -124,10 +124,8 @@ void add_run(Region& r, int64_t xa, int64_t xb, int64_t y, const uint8_t* bgr, i
   r.x_min = std::min(r.x_min, static_cast<int>(xa)),
   r.x_max = std::max(r.x_max, static_cast<int>(xb));
   r.y_max = static_cast<int>(y);
-  const auto [b, g, red] =
-      channel_sums(bgr, static_cast<size_t>(n), static_cast<size_t>(std::max(0, readable)));
-  r.sum_b += static_cast<int64_t>(b), r.sum_g += static_cast<int64_t>(g);
-  r.sum_r += static_cast<int64_t>(red);
+  add_channel_sums(bgr, static_cast<size_t>(n), static_cast<size_t>(std::max(0, readable)),
+                   &r.sum_b, &r.sum_g, &r.sum_r);
 }
 
 }  // namespace
