@@ -106,7 +106,9 @@ Frames render(const std::string& calibration) {
 struct Run {
   std::string name;
   sg::LatencyRecord position, trajectory;
-  std::string vision_own;  ///< sg-vision's summary line
+  std::string vision_own;       ///< sg-vision's summary line
+  std::string vision_delivery;  ///< ... the part of it before the image's handler (LCM)
+  std::string vision_handler;   ///< ... and the part of it in the image's handler
 };
 
 /// Waits until both processes announce themselves on PROCESS_STATUS.
@@ -116,10 +118,20 @@ bool wait_ready(sg::Bus& bus, bool& vision, bool& predictor) {
   return vision && predictor;
 }
 
+/// How the runs go: the bus, the frames' rate and count, sg-vision's real-time priority.
+struct RunSettings {
+  std::string url, dir;
+  int pairs = 300;
+  double rate = 20;
+  int realtime_priority = 0;
+};
+
 /// One run: the two programs, `pairs` frames at `rate` Hz, what arrived.
-void run(const std::string& url, const std::string& dir,
-         const std::vector<std::array<image_t, 2>>& frames, const std::string& decode, int pairs,
-         double rate, Run& out) {
+void run(const RunSettings& rs, const std::vector<std::array<image_t, 2>>& frames,
+         const std::string& decode, Run& out) {
+  const std::string &url = rs.url, &dir = rs.dir;
+  const int pairs = rs.pairs;
+  const double rate = rs.rate;
   sg::Bus bus(url);
   bool vision_up = false, predictor_up = false;
   bus.subscribe<stereograsp::process_status_t>("PROCESS_STATUS", [&](const auto& m, const auto&) {
@@ -132,10 +144,11 @@ void run(const std::string& url, const std::string& dir,
                                            [&](const auto& m, const auto& info) {
                                              out.trajectory.add(info.recv_utime - m.source_utime);
                                            });
-  Program vision("sg-vision",
-                 {"--calibration", dir + "/cams.yaml", "--decode", decode, "--lcm-url", url,
-                  "--log-level", "warn"},
-                 dir + "/vision.out");
+  Program vision(
+      "sg-vision",
+      {"--calibration", dir + "/cams.yaml", "--decode", decode, "--lcm-url", url, "--log-level",
+       "warn", "--realtime-priority", std::to_string(rs.realtime_priority)},
+      dir + "/vision.out");
   Program predictor("sg-predictor",
                     {"--config", dir + "/predictor.yaml", "--lcm-url", url, "--log-level", "warn"},
                     dir + "/predictor.out");
@@ -164,6 +177,10 @@ void run(const std::string& url, const std::string& dir,
   std::smatch m;
   if (std::regex_search(text, m, std::regex("OBJECT_POSITION published: ([^\n]*)")))
     out.vision_own = m[1];
+  if (std::regex_search(text, m, std::regex("handler \\([^)]*\\): ([^\n]*)")))
+    out.vision_handler = m[1];
+  if (std::regex_search(text, m, std::regex("delivery to the image's handler: ([^\n]*)")))
+    out.vision_delivery = m[1];
 }
 
 void print(const Run& r) {
@@ -174,6 +191,8 @@ void print(const Run& r) {
               static_cast<unsigned long long>(r.position.count()), ms(r.position, 0.5),
               ms(r.position, 0.99), static_cast<unsigned long long>(r.trajectory.count()),
               ms(r.trajectory, 0.5), ms(r.trajectory, 0.99), r.vision_own.c_str());
+  std::printf("%-22s %58s   of which LCM's delivery: %s\n", "", "", r.vision_delivery.c_str());
+  std::printf("%-22s %58s   of which the handler:    %s\n", "", "", r.vision_handler.c_str());
 }
 
 }  // namespace
@@ -190,6 +209,13 @@ int main(int argc, char** argv) {
   app.add_option("--rate", rate, "pairs a second (the predictor's period is set to match)")
       ->check(CLI::Range(1.0, 100.0));
   app.add_option("--lcm-url", url, "the bus (this host only: ttl=0)");
+  bool region_only = false;
+  int realtime = 0;
+  app.add_option("--realtime-priority", realtime,
+                 "sg-vision's vision.realtime_priority (SCHED_FIFO, memory locked; 0: off)")
+      ->check(CLI::Range(0, 99));
+  app.add_flag("--region-only", region_only,
+               "only the JPEG run with the windows decoded (the issue's figure)");
   CLI11_PARSE(app, argc, argv);
   try {
     const std::string dir =
@@ -198,14 +224,21 @@ int main(int argc, char** argv) {
     std::ofstream(dir + "/predictor.yaml") << "predictor:\n  period: " << 1.0 / rate << "\n";
     std::printf("rendering and encoding 60 stereo frames...\n");
     const Frames frames = render(dir + "/cams.yaml");
-    std::vector<Run> runs(3);
-    runs[0].name = "JPEG, windows decoded", runs[1].name = "JPEG, whole frames",
-    runs[2].name = "raw BGR8";
-    run(url, dir, frames.jpeg, "region", pairs, rate, runs[0]);
-    run(url, dir, frames.jpeg, "full", pairs, rate, runs[1]);
-    run(url, dir, frames.raw, "region", pairs, rate, runs[2]);
-    std::printf("\n%d pairs at %.0f Hz, one host, ms from the frames' publication (utime):\n",
-                pairs, rate);
+    std::vector<Run> runs(region_only ? 1 : 3);
+    runs[0].name = "JPEG, windows decoded";
+    const RunSettings rs{url, dir, pairs, rate, realtime};
+    run(rs, frames.jpeg, "region", runs[0]);
+    if (!region_only) {
+      runs[1].name = "JPEG, whole frames", runs[2].name = "raw BGR8";
+      run(rs, frames.jpeg, "full", runs[1]);
+      run(rs, frames.raw, "region", runs[2]);
+    }
+    std::printf(
+        "\n%d pairs at %.0f Hz, one host, sg-vision %s, ms from the frames' publication "
+        "(utime):\n",
+        pairs, rate,
+        realtime ? ("at SCHED_FIFO " + std::to_string(realtime)).c_str()
+                 : "on the ordinary scheduler");
     std::printf("%-22s %6s  %7s %7s   %8s  %7s %7s   %s\n", "frames", "points", "p50", "p99",
                 "trajects", "p50", "p99",
                 "sg-vision's own: second image received -> OBJECT_POSITION");

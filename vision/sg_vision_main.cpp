@@ -22,6 +22,7 @@
 #include "common/clock.hpp"
 #include "common/latency_record.hpp"
 #include "common/program.hpp"
+#include "common/realtime.hpp"
 #include "common/shutdown.hpp"
 #include "vision/blob_tracker.hpp"
 #include "vision/calibration_file.hpp"
@@ -61,7 +62,9 @@ class StereoVision {
         step_(settings.tracker, size, std::move(calibration), settings.match),
         publish_images_(publish_images) {}
 
-  void process(const cv::Mat& left, const cv::Mat& right, int64_t frame_number, int64_t utime) {
+  /// Tracks a pair and publishes OBJECT_POSITION (when seen), then BLOB_LEFT and BLOB_RIGHT;
+  /// returns when OBJECT_POSITION went out (sg::now_utime(); 0 when there was none).
+  int64_t process(const cv::Mat& left, const cv::Mat& right, int64_t frame_number, int64_t utime) {
     if (publish_images_) {
       const cv::Mat* images[2] = {&left, &right};
       for (int i = 0; i < 2; ++i)
@@ -71,9 +74,11 @@ class StereoVision {
     }
     const sg::vision::StereoOutput out = step_.process(left, right, frame_number, utime);
     // The position first, so that a viewer drawing on the blobs has the frame's position too.
-    if (out.position) bus_.publish("OBJECT_POSITION", *out.position);
+    int64_t published = 0;
+    if (out.position) bus_.publish("OBJECT_POSITION", *out.position), published = sg::now_utime();
     bus_.publish("BLOB_LEFT", out.blob[0]);
     bus_.publish("BLOB_RIGHT", out.blob[1]);
+    return published;
   }
 
   cv::Rect next_window(size_t camera, cv::Size frame) const {
@@ -110,6 +115,7 @@ class BusFrames {
         decoders_{sg::vision::FrameDecoder(mode), sg::vision::FrameDecoder(mode)} {}
 
   void on_image(const image_t& m, const sg::ReceiveInfo& info) {
+    const int64_t start = sg::now_utime();
     const int side = info.channel == "CAMERA_LEFT" ? 0 : 1;
     if (const std::string e = sg::vision::image_message_error(m); !e.empty()) return drop(info, e);
     auto pair = pairer_.add(side, m.utime, m);
@@ -122,8 +128,13 @@ class BusFrames {
       frames[i] = decoders_[i].decode(*messages[i], vision_.next_window(i, size), &error);
       if (!frames[i]) return drop(info, error);
     }
-    vision_.process(*frames[0], *frames[1], pair->first.frame_number, pair->first.utime);
-    pair_to_position_.add(sg::now_utime() - info.recv_utime);
+    const int64_t published =
+        vision_.process(*frames[0], *frames[1], pair->first.frame_number, pair->first.utime);
+    if (published != 0) {  // the stopwatch stops at OBJECT_POSITION, not at the blobs after it
+      pair_to_position_.add(published - info.recv_utime);
+      delivery_.add(start - info.recv_utime);
+      handling_.add(published - start);
+    }
     ++pairs_;
   }
 
@@ -133,6 +144,10 @@ class BusFrames {
     std::printf("second image received -> OBJECT_POSITION published: %s (decode: %s)\n",
                 pair_to_position_.summary().c_str(),
                 decoders_[0].mode() == sg::vision::FrameDecoder::Mode::kRegion ? "region" : "full");
+    std::printf("  of which LCM's delivery to the image's handler: %s\n",
+                delivery_.summary().c_str());
+    std::printf("  of which in the image's handler (decode, track, publish): %s\n",
+                handling_.summary().c_str());
   }
 
  private:
@@ -144,7 +159,7 @@ class BusFrames {
   StereoVision& vision_;
   sg::vision::StereoPairer<image_t> pairer_;
   sg::vision::FrameDecoder decoders_[2];
-  sg::LatencyRecord pair_to_position_;
+  sg::LatencyRecord pair_to_position_, delivery_, handling_;
   uint64_t bad_ = 0;
   int64_t pairs_ = 0;
 };
@@ -277,6 +292,7 @@ int main(int argc, char** argv) {
   sg::add_common_options(app, common);
   const auto keys = sg::declared_keys(sg::vision::read_vision_settings);
   common.flags.add(app, "--decode", "vision.decode", keys);
+  common.flags.add(app, "--realtime-priority", "vision.realtime_priority", keys);
   Options o;
   app.add_option("--source", o.source, "lcm (CAMERA_LEFT/RIGHT), video, images or v4l2")
       ->check(CLI::IsMember({"lcm", "video", "images", "v4l2"}));
@@ -312,6 +328,9 @@ int main(int argc, char** argv) {
       throw std::runtime_error(
           "--publish-images republishes frames from cameras or files, not from the bus");
     sg::install_shutdown_handlers();
+    // Before the bus: LCM's receive thread inherits the policy.
+    if (const std::string e = sg::enter_realtime(settings.realtime_priority); !e.empty())
+      spdlog::warn("{}", e);
     sg::Bus bus(common.lcm_url);
     const cv::Size size = calibration
                               ? cv::Size(calibration->left.width(), calibration->left.height())

@@ -16,6 +16,9 @@ struct VisionSettings {
   /// JPEGs from the bus: "region" decodes only the search windows while tracking
   /// (frame_decoder.hpp), "full" every frame whole (the baseline).
   std::string decode = "region";
+  /// SCHED_FIFO priority for sg-vision and its LCM thread, with its memory locked
+  /// (common/realtime.hpp); 0: the ordinary scheduler.
+  int realtime_priority = 0;
 };
 
 /// Reads the `vision` section: every key range-checked, any other key of the section refused
