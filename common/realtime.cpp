@@ -1,5 +1,6 @@
 #include "common/realtime.hpp"
 
+#include <malloc.h>
 #include <sched.h>
 #include <sys/mman.h>
 
@@ -24,6 +25,10 @@ std::string enter_realtime(int priority) {
   p.sched_priority = priority;
   if (sched_setscheduler(0, SCHED_FIFO, &p) != 0) note("SCHED_FIFO " + std::to_string(priority));
   if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) note("mlockall");
+  // Freed memory stays in the heap, and large blocks come from it too (no mmap): a frame's
+  // buffers are reused without a system call or a page fault.
+  mallopt(M_TRIM_THRESHOLD, -1);
+  mallopt(M_MMAP_MAX, 0);
   return problems.empty() ? "" : "real time not entered (" + problems + ")";
 }
 

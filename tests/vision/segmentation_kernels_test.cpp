@@ -23,11 +23,15 @@ namespace {
 
 /// Threshold sets: the shipped red, the widest, an upper bound of 1 and one of 0, a narrow one.
 std::vector<ColorThresholds> threshold_sets() {
-  std::vector<ColorThresholds> v(5);
+  std::vector<ColorThresholds> v(8);
   v[1] = {0, 1, 0, 1, 0, 1, 0};
   v[2] = {0.2, 1.0, 0.0, 1.0, 0.1, 0.5, 1};
   v[3] = {0.0, 0.0, 0.3, 0.7, 0.3, 0.7, 765};
   v[4] = {0.5123, 0.5189, 0.2, 0.25, 0.2, 0.3, 30};
+  // r_min where the 8-bit skip's factor changes (1/2, 1, 3/2: 1/3, 1/2, 3/5) and a learned red.
+  v[5] = {1.0 / 3, 1.0, 0.0, 0.3, 0.0, 0.3, 60};
+  v[6] = {0.6, 0.9, 0.0, 0.3, 0.0, 0.3, 60};
+  v[7] = {0.62, 0.93, 0.04, 0.26, 0.02, 0.24, 60};
   return v;
 }
 
