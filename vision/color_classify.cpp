@@ -127,7 +127,7 @@ HWY_INLINE void classify_row(D8 d8, const uint8_t* HWY_RESTRICT bgr, size_t n, s
 }
 
 void ClassifyRows(const ClassifyRowsArgs& a, const ColorBounds& k) {
-  const hn::ScalableTag<uint8_t> d8;
+  const hn::CappedTag<uint8_t, 64> d8;  // at most 64 pixels a step: one word of bits
   for (size_t y = 0; y < a.height; ++y) {
     classify_row(d8, a.bgr + y * a.stride, a.width, a.readable, a.bits + y * a.words_per_row, k);
   }
