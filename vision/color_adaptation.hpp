@@ -4,8 +4,8 @@
 /// normalized RGB (eq. 7) is cut to the central pixels of confidently found, fully visible ball
 /// images, and follows a lighting drift — within the configured ranges, never beyond them.
 ///
-/// For each band (r, g, b) the pixels within `inner` radii of the ball's centre (on a square grid
-/// of about 150 of them, whatever the ball's size) give the
+/// For each band (r, g, b) the pixels within `inner` radii of the ball's centre (every other one,
+/// on a coarser grid for a near ball: at most about 300) give the
 /// `quantile` and 1 - `quantile` values q_lo, q_hi of one frame; their exponentially weighted
 /// averages (weight `rate`) L, H give the band
 ///
