@@ -3,8 +3,8 @@
 //
 // Each of the six bounds of eq. 8 is a test X <= floor(q S / 2^15) of an integer X against the
 // high half of a 16-bit product (color_detector.hpp says why that is exactly is_object()), so a
-// pixel costs 16-bit adds, six MulHigh and six compares: 16 pixels a vector with AVX2, 32 with
-// AVX-512.
+// pixel costs 16-bit adds, six MulHigh and seven compares; a step is a vector of bytes (32 pixels
+// with AVX2, 64 with AVX-512), each half widened to 16-bit lanes.
 
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "vision/color_classify.cpp"
