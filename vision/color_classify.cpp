@@ -31,46 +31,91 @@ HWY_INLINE uint64_t mask_bits(D d, M ok) {
   return word;
 }
 
+/// A vector of pixels in 16-bit lanes, with S = B+G+R.
+template <class V>
+struct Pixels {
+  V b, g, r, s;
+};
+
+template <class D16, class V>
+HWY_INLINE Pixels<V> pixels(D16, V b, V g, V r) {
+  return {b, g, r, hn::Add(hn::Add(b, g), r)};
+}
+
+/// The lanes that fail bound i (ColorBounds's numbering): X > floor(q S / 2^15), or S < min_sum.
+/// X in lanes as signed (all values <= 765): Gt is signed on x86 before AVX-512.
+template <int i, class D16, class V>
+HWY_INLINE auto fails(D16 d16, const Pixels<V>& p, const ColorBounds& k) {
+  const hn::RebindToSigned<D16> di;
+  if constexpr (i == kMinSumBound) {
+    return hn::Lt(hn::BitCast(di, p.s), hn::Set(di, k.min_sum));
+  } else {
+    const V x = i == 0 ? p.r : i == 1 ? hn::Add(p.g, p.b) : i == 2 ? p.g
+              : i == 3 ? hn::Add(p.r, p.b) : i == 4 ? p.b : hn::Add(p.r, p.g);
+    const V bound = hn::MulHigh(hn::Add(p.s, p.s), hn::Set(d16, k.q[i]));  // floor(q S / 2^15)
+    return hn::Gt(hn::BitCast(di, x), hn::BitCast(di, bound));
+  }
+}
+
 /// One vector of pixels: the mask of those of the object's colour.
 template <class D16, class V>
-HWY_INLINE auto object_lanes(D16 d16, V b, V g, V r, const ColorBounds& k) {
-  const hn::RebindToSigned<D16> di;
-  const V s = hn::Add(hn::Add(b, g), r), twice_s = hn::Add(s, s);
-  // X in lanes as signed (all values <= 765): Gt is signed on x86 before AVX-512.
-  auto over = [&](V x, int i) {
-    const V bound = hn::MulHigh(twice_s, hn::Set(d16, k.q[i]));  // floor(q S / 2^15)
-    return hn::Gt(hn::BitCast(di, x), hn::BitCast(di, bound));
-  };
-  auto fail = hn::Lt(hn::BitCast(di, s), hn::Set(di, k.min_sum));
-  fail = hn::Or(fail, over(r, 0));
-  fail = hn::Or(fail, over(hn::Add(g, b), 1));
-  fail = hn::Or(fail, over(g, 2));
-  fail = hn::Or(fail, over(hn::Add(r, b), 3));
-  fail = hn::Or(fail, over(b, 4));
-  fail = hn::Or(fail, over(hn::Add(r, g), 5));
+HWY_INLINE auto object_lanes(D16 d16, const Pixels<V>& p, const ColorBounds& k) {
+  auto fail = hn::Or(fails<kMinSumBound>(d16, p, k), fails<0>(d16, p, k));
+  fail = hn::Or(fail, fails<1>(d16, p, k));
+  fail = hn::Or(fail, fails<2>(d16, p, k));
+  fail = hn::Or(fail, fails<3>(d16, p, k));
+  fail = hn::Or(fail, fails<4>(d16, p, k));
+  fail = hn::Or(fail, fails<5>(d16, p, k));
   return hn::RebindMask(d16, hn::Not(fail));
 }
 
+/// For a vector of pixels none of which is the colour (its halves lo and hi): the bounds that
+/// reject every one.
+template <class D16, class V>
+HWY_NOINLINE void tally_rejections(D16 d16, const Pixels<V>& lo, const Pixels<V>& hi,
+                                   const ColorBounds& k, ClassifyTally& tally) {
+  const hn::RebindToSigned<D16> di;
+  auto whole = [&](auto a, auto b) { return hn::AllTrue(di, hn::And(a, b)) ? 1u : 0u; };
+  tally.rejected_by[0] += whole(fails<0>(d16, lo, k), fails<0>(d16, hi, k));
+  tally.rejected_by[1] += whole(fails<1>(d16, lo, k), fails<1>(d16, hi, k));
+  tally.rejected_by[2] += whole(fails<2>(d16, lo, k), fails<2>(d16, hi, k));
+  tally.rejected_by[3] += whole(fails<3>(d16, lo, k), fails<3>(d16, hi, k));
+  tally.rejected_by[4] += whole(fails<4>(d16, lo, k), fails<4>(d16, hi, k));
+  tally.rejected_by[5] += whole(fails<5>(d16, lo, k), fails<5>(d16, hi, k));
+  tally.rejected_by[6] += whole(fails<6>(d16, lo, k), fails<6>(d16, hi, k));
+}
+
 /// One vector of bytes' worth of pixels from `bgr` (Lanes(d8), at most 64): pixel i's test at
-/// bit i. The bytes are loaded whole, each half widened to 16-bit lanes.
-template <class D8>
-HWY_INLINE uint64_t classify_step(D8 d8, const uint8_t* HWY_RESTRICT bgr, const ColorBounds& k) {
+/// bit i. The bytes are loaded whole, each half widened to 16-bit lanes; bound kFirst alone
+/// first, the rest only when some pixel passes it.
+template <int kFirst, class D8>
+HWY_INLINE uint64_t classify_step(D8 d8, const uint8_t* HWY_RESTRICT bgr, const ColorBounds& k,
+                                  ClassifyTally& tally) {
   hn::Vec<D8> b, g, r;
   hn::LoadInterleaved3(d8, bgr, b, g, r);
 #if HWY_TARGET == HWY_SCALAR  // one lane: no halves
   const hn::Rebind<uint16_t, D8> d16;
-  return mask_bits(d16, object_lanes(d16, hn::PromoteTo(d16, b), hn::PromoteTo(d16, g),
-                                     hn::PromoteTo(d16, r), k));
+  const auto p = pixels(d16, hn::PromoteTo(d16, b), hn::PromoteTo(d16, g), hn::PromoteTo(d16, r));
+  (void)tally;
+  return mask_bits(d16, object_lanes(d16, p, k));
 #else
   const hn::Half<D8> dh;
   const hn::Rebind<uint16_t, decltype(dh)> d16;
-  const auto lower = object_lanes(d16, hn::PromoteTo(d16, hn::LowerHalf(dh, b)),
-                                  hn::PromoteTo(d16, hn::LowerHalf(dh, g)),
-                                  hn::PromoteTo(d16, hn::LowerHalf(dh, r)), k);
-  const auto upper = object_lanes(d16, hn::PromoteTo(d16, hn::UpperHalf(dh, b)),
-                                  hn::PromoteTo(d16, hn::UpperHalf(dh, g)),
-                                  hn::PromoteTo(d16, hn::UpperHalf(dh, r)), k);
-  return mask_bits(d16, lower) | mask_bits(d16, upper) << hn::Lanes(d16);
+  const hn::RebindToSigned<decltype(d16)> di;
+  const auto lo = pixels(d16, hn::PromoteTo(d16, hn::LowerHalf(dh, b)),
+                         hn::PromoteTo(d16, hn::LowerHalf(dh, g)),
+                         hn::PromoteTo(d16, hn::LowerHalf(dh, r)));
+  const auto hi = pixels(d16, hn::PromoteTo(d16, hn::UpperHalf(dh, b)),
+                         hn::PromoteTo(d16, hn::UpperHalf(dh, g)),
+                         hn::PromoteTo(d16, hn::UpperHalf(dh, r)));
+  if (hn::AllTrue(di, hn::And(fails<kFirst>(d16, lo, k), fails<kFirst>(d16, hi, k)))) {
+    ++tally.skipped;
+    return 0;
+  }
+  const uint64_t bits = mask_bits(d16, object_lanes(d16, lo, k)) |
+                        mask_bits(d16, object_lanes(d16, hi, k)) << hn::Lanes(d16);
+  if (bits == 0) tally_rejections(d16, lo, hi, k, tally);
+  return bits;
 #endif
 }
 
@@ -90,24 +135,25 @@ hn::Half<D8> half_of(D8) {
 /// One row: bits[i / 64] bit i % 64 for pixel i < n, the last word's bits past n zero; pixels up
 /// to `readable` may be read. Whole vectors of bytes; the last pixels in one more where it may be
 /// read in place (at a row's end: half a vector, then the rest through a copy).
-template <class D8>
+template <int kFirst, class D8>
 HWY_INLINE void classify_row(D8 d8, const uint8_t* HWY_RESTRICT bgr, size_t n, size_t readable,
-                             uint64_t* HWY_RESTRICT bits, const ColorBounds& k) {
+                             uint64_t* HWY_RESTRICT bits, const ColorBounds& k,
+                             ClassifyTally& tally) {
   const auto dh = half_of(d8);
   const size_t lanes = hn::Lanes(d8), half = hn::Lanes(dh);  // powers of two up to 64
   uint64_t word = 0;
   size_t i = 0;
   for (; i + lanes <= n; i += lanes) {
-    word |= classify_step(d8, bgr + 3 * i, k) << (i % 64);
+    word |= classify_step<kFirst>(d8, bgr + 3 * i, k, tally) << (i % 64);
     if ((i + lanes) % 64 == 0) bits[i / 64] = word, word = 0;
   }
   if (i < n && i + lanes <= readable) {  // the last pixels in place, in a whole vector
     const uint64_t valid = ~uint64_t{0} >> (64 - (n - i));
-    word |= (classify_step(d8, bgr + 3 * i, k) & valid) << (i % 64);
+    word |= (classify_step<kFirst>(d8, bgr + 3 * i, k, tally) & valid) << (i % 64);
     i = n;
   }
   if (half < lanes && i + half <= n) {  // i % 64 + half < 64: no word fills
-    word |= classify_step(dh, bgr + 3 * i, k) << (i % 64);
+    word |= classify_step<kFirst>(dh, bgr + 3 * i, k, tally) << (i % 64);
     i += half;
   }
   if (i < n) {
@@ -120,16 +166,32 @@ HWY_INLINE void classify_row(D8 d8, const uint8_t* HWY_RESTRICT bgr, size_t n, s
       last = static_cast<const uint8_t*>(std::memcpy(tail, last, 3 * (n - i)));
     }
     const uint64_t valid = ~uint64_t{0} >> (64 - (n - i));
-    word |= (classify_step(dh, last, k) & valid) << (i % 64);
+    word |= (classify_step<kFirst>(dh, last, k, tally) & valid) << (i % 64);
     i = n;
   }
   if (i % 64 != 0) bits[i / 64] = word;
 }
 
-void ClassifyRows(const ClassifyRowsArgs& a, const ColorBounds& k) {
+template <int kFirst>
+ClassifyTally classify_rows(const ClassifyRowsArgs& a, const ColorBounds& k) {
   const hn::CappedTag<uint8_t, 64> d8;  // at most 64 pixels a step: one word of bits
+  ClassifyTally tally;
   for (size_t y = 0; y < a.height; ++y) {
-    classify_row(d8, a.bgr + y * a.stride, a.width, a.readable, a.bits + y * a.words_per_row, k);
+    classify_row<kFirst>(d8, a.bgr + y * a.stride, a.width, a.readable,
+                         a.bits + y * a.words_per_row, k, tally);
+  }
+  return tally;
+}
+
+ClassifyTally ClassifyRows(const ClassifyRowsArgs& a, const ColorBounds& k) {
+  switch (a.first_bound) {
+    case 0: return classify_rows<0>(a, k);
+    case 1: return classify_rows<1>(a, k);
+    case 3: return classify_rows<3>(a, k);
+    case 4: return classify_rows<4>(a, k);
+    case 5: return classify_rows<5>(a, k);
+    case kMinSumBound: return classify_rows<kMinSumBound>(a, k);
+    default: return classify_rows<2>(a, k);
   }
 }
 
@@ -148,9 +210,14 @@ void ColorDetector::classify(const uint8_t* bgr, int n, uint64_t* bits, int read
       {bgr, 0, static_cast<size_t>(n), 1, static_cast<size_t>(std::max(n, readable)), bits, 0});
 }
 
-void ColorDetector::classify_rows(const ClassifyRowsArgs& rows) const {
-  if (rows.width == 0 || rows.height == 0) return;
-  HWY_DYNAMIC_DISPATCH(ClassifyRows)(rows, bounds_);
+ClassifyTally ColorDetector::classify_rows(const ClassifyRowsArgs& rows) const {
+  if (rows.width == 0 || rows.height == 0) return {};
+  return HWY_DYNAMIC_DISPATCH(ClassifyRows)(rows, bounds_);
+}
+
+int ClassifyTally::next_first_bound(int current) const {
+  const uint32_t* best = std::max_element(rejected_by, rejected_by + kBounds);
+  return *best > 2 * skipped + 4 ? static_cast<int>(best - rejected_by) : current;
 }
 
 }  // namespace sg::vision

@@ -33,14 +33,32 @@ struct ColorBounds {
   int16_t min_sum = 1;  ///< R+G+B below it fails (at most 766: never)
 };
 
+/// The bounds of ColorBounds by number: 0-5 its q in order, kMinSumBound R+G+B >= min_sum.
+inline constexpr int kBounds = 7, kMinSumBound = 6;
+
 /// A block of rows for ColorDetector::classify_rows: `height` rows of `width` BGR pixels,
 /// `stride` bytes apart from `bgr`, each readable to pixel `readable` (>= width), their bits in
-/// rows of `words_per_row` 64-bit words from `bits`.
+/// rows of `words_per_row` 64-bit words from `bits`. Each vector of pixels is first tested
+/// against bound `first_bound` alone and skipped when it rejects them all (the result does not
+/// depend on it; the speed does: the bound that rejects most of the scene's background first).
 struct ClassifyRowsArgs {
   const uint8_t* bgr;
   size_t stride, width, height, readable;
   uint64_t* bits;
   size_t words_per_row;
+  int first_bound = 2;  ///< 0..kBounds-1; G <= g_max: a lab's grey, wooden and green surfaces
+};
+
+/// What classify_rows saw, to choose the next call's first bound: the vectors of pixels (up to
+/// 64) that the first bound rejected whole, and among the others with no pixel of the colour,
+/// how many each bound would have rejected whole.
+struct ClassifyTally {
+  uint32_t skipped = 0;
+  uint32_t rejected_by[kBounds] = {};
+
+  /// The bound to test first next time: the one that would have skipped the most, when it
+  /// beats the current one's skips clearly (twice, and by 4: no flapping between two).
+  int next_first_bound(int current) const;
 };
 
 /// The paper's threshold (eq. 8) on normalized RGB (eq. 7), in integer arithmetic with no
@@ -71,7 +89,7 @@ class ColorDetector {
   /// the last vector is read in place rather than copied.
   void classify(const uint8_t* bgr, int n, uint64_t* bits, int readable = 0) const;
   /// classify() of a block of rows (a search window) in one call.
-  void classify_rows(const ClassifyRowsArgs& rows) const;
+  ClassifyTally classify_rows(const ClassifyRowsArgs& rows) const;
 
   const ColorThresholds& thresholds() const { return t_; }
 

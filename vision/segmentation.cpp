@@ -147,9 +147,11 @@ void Segmenter::label_runs(const cv::Mat& bgr, const ColorDetector& detector) {
   next_ = 1;
   parent_[0] = 0;
   size_t count = 0;
-  detector.classify_rows({bgr.ptr<uint8_t>(w.y) + 3 * w.x, bgr.step[0],
-                          static_cast<size_t>(w.width), static_cast<size_t>(w.height),
-                          static_cast<size_t>(bgr.cols - w.x), window_bits_.data(), bits_per_row_});
+  const ClassifyTally tally = detector.classify_rows(
+      {bgr.ptr<uint8_t>(w.y) + 3 * w.x, bgr.step[0], static_cast<size_t>(w.width),
+       static_cast<size_t>(w.height), static_cast<size_t>(bgr.cols - w.x), window_bits_.data(),
+       bits_per_row_, first_bound_});
+  first_bound_ = tally.next_first_bound(first_bound_);
   for (int y = 0; y < w.height; ++y) {
     const uint8_t* in = bgr.ptr<uint8_t>(w.y + y) + 3 * w.x;
     const uint64_t* row_bits = window_bits_.data() + static_cast<size_t>(y) * bits_per_row_;

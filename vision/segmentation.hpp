@@ -93,6 +93,8 @@ class Segmenter {
   std::vector<size_t> row_start_;      // kRuns: each row's first run, and the end
   size_t bits_per_row_ = 0;            // kRuns: words a row of window_bits_
   std::vector<uint64_t> window_bits_;  // kRuns: classify_rows()'s output for the window
+  int first_bound_ = ClassifyRowsArgs{}.first_bound;  // kRuns: the bound classify_rows tests
+                                                       // first, from the last window's tally
   cv::Rect window_;
   cv::Point mask_origin_;
   int32_t next_ = 1;

@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 #include <hwy/targets.h>
 
+#include <algorithm>
+#include <bit>
 #include <numeric>
 #include <opencv2/imgcodecs.hpp>
 #include <random>
@@ -38,34 +40,75 @@ std::vector<ColorThresholds> threshold_sets() {
 /// classify()'s bit for pixel i.
 bool bit(const std::vector<uint64_t>& bits, size_t i) { return (bits[i / 64] >> (i % 64)) & 1; }
 
-// Every one of the 2^24 colours, with every instruction set Highway compiled that this CPU has:
-// classify() says what is_object() says.
+// Every one of the 2^24 colours, with every instruction set Highway compiled that this CPU has
+// and each bound tested first: classify_rows() says what is_object() says.
 TEST(ColorKernels, ClassifyIsIsObjectForEveryColour) {
   const size_t n = size_t{1} << 24;
   std::vector<uint8_t> bgr(3 * n);
-  std::vector<uint64_t> bits(n / 64);
+  std::vector<uint64_t> bits(n / 64), want(n / 64);
   for (size_t i = 0; i < n; ++i) {
     bgr[3 * i] = static_cast<uint8_t>(i), bgr[3 * i + 1] = static_cast<uint8_t>(i >> 8);
     bgr[3 * i + 2] = static_cast<uint8_t>(i >> 16);
   }
   const std::vector<int64_t> targets = hwy::SupportedAndGeneratedTargets();
   ASSERT_FALSE(targets.empty());
-  for (const int64_t target : targets) {
-    hwy::SetSupportedTargetsForTest(target);
-    for (const ColorThresholds& t : threshold_sets()) {
-      const ColorDetector d(t);
-      d.classify(bgr.data(), static_cast<int>(n), bits.data());
-      size_t wrong = 0, objects = 0;
-      for (size_t i = 0; i < n; ++i) {
-        const bool is = d.is_object(&bgr[3 * i]);
-        objects += is;
-        wrong += bit(bits, i) != is;
+  for (const ColorThresholds& t : threshold_sets()) {
+    const ColorDetector d(t);
+    std::fill(want.begin(), want.end(), 0);
+    for (size_t i = 0; i < n; ++i) want[i / 64] |= uint64_t{d.is_object(&bgr[3 * i])} << (i % 64);
+    for (const int64_t target : targets) {
+      hwy::SetSupportedTargetsForTest(target);
+      for (int first = 0; first < kBounds; ++first) {
+        ClassifyRowsArgs rows{bgr.data(), 0, n, 1, n, bits.data(), 0, first};
+        const ClassifyTally tally = d.classify_rows(rows);
+        size_t wrong = 0;
+        for (size_t w = 0; w < bits.size(); ++w) wrong += std::popcount(bits[w] ^ want[w]);
+        EXPECT_EQ(wrong, 0u) << hwy::TargetName(target) << ", bound " << first << " first, r "
+                             << t.r_min << "-" << t.r_max << ", " << tally.skipped << " skipped";
       }
-      EXPECT_EQ(wrong, 0u) << hwy::TargetName(target) << ", r " << t.r_min << "-" << t.r_max << ", "
-                           << objects << " objects";
     }
   }
   hwy::SetSupportedTargetsForTest(0);
+}
+
+// The tally: the vectors the first bound skipped, the others' whole rejections, and the next
+// first bound: 64 pixels too dark (min_sum) then 64 too green (g > g_max), AVX-512's 64 a step
+// or two to four smaller ones.
+TEST(ColorKernels, ClassifyTallyCountsWholeRejections) {
+  std::vector<uint8_t> bgr(3 * 128);
+  for (size_t i = 0; i < 64; ++i) bgr[3 * i + 2] = 10;                          // dark red
+  for (size_t i = 64; i < 128; ++i) bgr[3 * i + 1] = 200, bgr[3 * i + 2] = 100;  // green
+  const ColorDetector d(ColorThresholds{});
+  std::vector<uint64_t> bits(2, ~uint64_t{0});
+  for (const int64_t target : hwy::SupportedAndGeneratedTargets()) {
+    hwy::SetSupportedTargetsForTest(target);
+    if (target == HWY_SCALAR) continue;  // one pixel a step: no skipping
+    const ClassifyTally t = d.classify_rows({bgr.data(), 0, 128, 1, 128, bits.data(), 0, 2});
+    const uint32_t steps = t.skipped + t.rejected_by[kMinSumBound];
+    EXPECT_EQ(bits[0] | bits[1], 0u);
+    EXPECT_TRUE(steps == 2 || steps == 4 || steps == 8) << hwy::TargetName(target);
+    EXPECT_EQ(t.skipped, steps / 2) << hwy::TargetName(target);  // the green half
+    EXPECT_EQ(t.rejected_by[2], 0u);  // skipped, so not counted again
+    EXPECT_EQ(t.rejected_by[1], 0u);  // dark red passes r >= r_min; the green was skipped
+    EXPECT_EQ(t.next_first_bound(2), 2) << "as many skipped as min_sum would";
+    const ClassifyTally first_dark =
+        d.classify_rows({bgr.data(), 0, 128, 1, 128, bits.data(), 0, kMinSumBound});
+    EXPECT_EQ(first_dark.skipped, steps / 2) << hwy::TargetName(target);
+    EXPECT_EQ(first_dark.rejected_by[2], steps / 2) << hwy::TargetName(target);
+  }
+  hwy::SetSupportedTargetsForTest(0);
+}
+
+// next_first_bound: another bound only when it would have skipped more than twice as many, and
+// 4 more.
+TEST(ColorKernels, NextFirstBoundNeedsAClearWinner) {
+  ClassifyTally t;
+  t.skipped = 10, t.rejected_by[4] = 24;
+  EXPECT_EQ(t.next_first_bound(2), 2);
+  t.rejected_by[4] = 25;
+  EXPECT_EQ(t.next_first_bound(2), 4);
+  t.skipped = 0, t.rejected_by[4] = 4;
+  EXPECT_EQ(t.next_first_bound(2), 2);
 }
 
 // Rows of every length up to three vectors, with every instruction set: the last pixels read in
