@@ -5,6 +5,7 @@
 #include <functional>
 #include <map>
 #include <string>
+#include <vector>
 
 namespace sg::bench {
 
@@ -22,6 +23,8 @@ class TimingReporter : public benchmark::ConsoleReporter {
   }
   /// Time per iteration in the benchmark's unit; throws std::out_of_range for an unknown name.
   double time(const std::string& name) const { return times_.at(name); }
+  /// Whether `name` ran (a --benchmark_filter may have left it out).
+  bool has(const std::string& name) const { return times_.count(name) != 0; }
   const std::map<std::string, double>& times() const { return times_; }
 
  private:
@@ -29,8 +32,16 @@ class TimingReporter : public benchmark::ConsoleReporter {
 };
 
 /// Runs the benchmarks given on the command line, then `after` with what was measured.
+/// `defaults`: flags as if given first on the command line (the user's own come after and win).
 inline int run_benchmarks(int argc, char** argv,
-                          const std::function<void(const TimingReporter&)>& after) {
+                          const std::function<void(const TimingReporter&)>& after,
+                          const std::vector<std::string>& defaults = {}) {
+  std::vector<std::string> flags(defaults);
+  std::vector<char*> args{argv[0]};
+  for (std::string& f : flags) args.push_back(f.data());
+  args.insert(args.end(), argv + 1, argv + argc);
+  args.push_back(nullptr);
+  argc = static_cast<int>(args.size()) - 1, argv = args.data();
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   TimingReporter reporter;
