@@ -42,6 +42,17 @@ HWY_INLINE Pixels<V> pixels(D16, V b, V g, V r) {
   return {b, g, r, hn::Add(hn::Add(b, g), r)};
 }
 
+/// The X of bound i: R, G+B, G, R+B, B, R+G.
+template <int i, class V>
+HWY_INLINE V bounded(const Pixels<V>& p) {
+  if constexpr (i == 0) return p.r;
+  if constexpr (i == 1) return hn::Add(p.g, p.b);
+  if constexpr (i == 2) return p.g;
+  if constexpr (i == 3) return hn::Add(p.r, p.b);
+  if constexpr (i == 4) return p.b;
+  return hn::Add(p.r, p.g);
+}
+
 /// The lanes that fail bound i (ColorBounds's numbering): X > floor(q S / 2^15), or S < min_sum.
 /// X in lanes as signed (all values <= 765): Gt is signed on x86 before AVX-512.
 template <int i, class D16, class V>
@@ -50,8 +61,7 @@ HWY_INLINE auto fails(D16 d16, const Pixels<V>& p, const ColorBounds& k) {
   if constexpr (i == kMinSumBound) {
     return hn::Lt(hn::BitCast(di, p.s), hn::Set(di, k.min_sum));
   } else {
-    const V x = i == 0 ? p.r : i == 1 ? hn::Add(p.g, p.b) : i == 2 ? p.g
-              : i == 3 ? hn::Add(p.r, p.b) : i == 4 ? p.b : hn::Add(p.r, p.g);
+    const V x = bounded<i>(p);
     const V bound = hn::MulHigh(hn::Add(p.s, p.s), hn::Set(d16, k.q[i]));  // floor(q S / 2^15)
     return hn::Gt(hn::BitCast(di, x), hn::BitCast(di, bound));
   }
@@ -102,12 +112,12 @@ HWY_INLINE uint64_t classify_step(D8 d8, const uint8_t* HWY_RESTRICT bgr, const 
   const hn::Half<D8> dh;
   const hn::Rebind<uint16_t, decltype(dh)> d16;
   const hn::RebindToSigned<decltype(d16)> di;
-  const auto lo = pixels(d16, hn::PromoteTo(d16, hn::LowerHalf(dh, b)),
-                         hn::PromoteTo(d16, hn::LowerHalf(dh, g)),
-                         hn::PromoteTo(d16, hn::LowerHalf(dh, r)));
-  const auto hi = pixels(d16, hn::PromoteTo(d16, hn::UpperHalf(dh, b)),
-                         hn::PromoteTo(d16, hn::UpperHalf(dh, g)),
-                         hn::PromoteTo(d16, hn::UpperHalf(dh, r)));
+  const auto lo =
+      pixels(d16, hn::PromoteTo(d16, hn::LowerHalf(dh, b)),
+             hn::PromoteTo(d16, hn::LowerHalf(dh, g)), hn::PromoteTo(d16, hn::LowerHalf(dh, r)));
+  const auto hi =
+      pixels(d16, hn::PromoteTo(d16, hn::UpperHalf(dh, b)),
+             hn::PromoteTo(d16, hn::UpperHalf(dh, g)), hn::PromoteTo(d16, hn::UpperHalf(dh, r)));
   if (hn::AllTrue(di, hn::And(fails<kFirst>(d16, lo, k), fails<kFirst>(d16, hi, k)))) {
     ++tally.skipped;
     return 0;
@@ -185,13 +195,20 @@ ClassifyTally classify_rows(const ClassifyRowsArgs& a, const ColorBounds& k) {
 
 ClassifyTally ClassifyRows(const ClassifyRowsArgs& a, const ColorBounds& k) {
   switch (a.first_bound) {
-    case 0: return classify_rows<0>(a, k);
-    case 1: return classify_rows<1>(a, k);
-    case 3: return classify_rows<3>(a, k);
-    case 4: return classify_rows<4>(a, k);
-    case 5: return classify_rows<5>(a, k);
-    case kMinSumBound: return classify_rows<kMinSumBound>(a, k);
-    default: return classify_rows<2>(a, k);
+    case 0:
+      return classify_rows<0>(a, k);
+    case 1:
+      return classify_rows<1>(a, k);
+    case 3:
+      return classify_rows<3>(a, k);
+    case 4:
+      return classify_rows<4>(a, k);
+    case 5:
+      return classify_rows<5>(a, k);
+    case kMinSumBound:
+      return classify_rows<kMinSumBound>(a, k);
+    default:
+      return classify_rows<2>(a, k);
   }
 }
 
