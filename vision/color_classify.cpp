@@ -95,29 +95,77 @@ HWY_NOINLINE void tally_rejections(D16 d16, const Pixels<V>& lo, const Pixels<V>
   tally.rejected_by[6] += whole(fails<6>(d16, lo, k), fails<6>(d16, hi, k));
 }
 
+#if HWY_TARGET != HWY_SCALAR
+/// A vector of bytes' worth of pixels (Lanes(d8)) from `bgr`, its two halves widened to 16-bit
+/// lanes: the bytes split into B, G and R vectors (LoadInterleaved3's shuffles), each half
+/// zero-extended.
+template <class D8, class V16>
+HWY_INLINE void widened(D8 d8, const uint8_t* HWY_RESTRICT bgr, Pixels<V16>& lo, Pixels<V16>& hi) {
+  const hn::Half<D8> dh;
+  const hn::Rebind<uint16_t, decltype(dh)> d16;
+  hn::Vec<D8> b, g, r;
+  hn::LoadInterleaved3(d8, bgr, b, g, r);
+  lo = pixels(d16, hn::PromoteTo(d16, hn::LowerHalf(dh, b)),
+              hn::PromoteTo(d16, hn::LowerHalf(dh, g)), hn::PromoteTo(d16, hn::LowerHalf(dh, r)));
+  hi = pixels(d16, hn::PromoteTo(d16, hn::UpperHalf(dh, b)),
+              hn::PromoteTo(d16, hn::UpperHalf(dh, g)), hn::PromoteTo(d16, hn::UpperHalf(dh, r)));
+}
+#endif
+
+#if HWY_TARGET == HWY_AVX3_DL
+/// vpermt2b's byte indices: for half h, channel c, output byte 2i the byte of pixel 32h + i
+/// (3 (32h + i) + c) in the two vectors from byte 64h; odd bytes (zeroed by the mask) 0.
+struct WidenIndices {
+  alignas(64) uint8_t of[2][3][64];
+};
+constexpr WidenIndices widen_indices() {
+  WidenIndices w{};
+  for (int h = 0; h < 2; ++h) {
+    for (int c = 0; c < 3; ++c) {
+      for (int i = 0; i < 32; ++i) w.of[h][c][2 * i] = static_cast<uint8_t>(3 * i + c + 32 * h);
+    }
+  }
+  return w;
+}
+inline constexpr WidenIndices kWidenIndices = widen_indices();
+
+/// With AVX-512 VBMI, 64 pixels: each half's B, G and R as 16-bit lanes in one byte permutation
+/// of two vectors of the interleaved bytes (vpermt2b, the high bytes zeroed by the mask),
+/// six instructions for LoadInterleaved3's dozen shuffles and the six widenings.
+template <class V16>
+HWY_INLINE void widened(hn::Simd<uint8_t, 64, 0>, const uint8_t* HWY_RESTRICT bgr,
+                        Pixels<V16>& lo, Pixels<V16>& hi) {
+  const hn::Simd<uint16_t, 32, 0> d16;
+  const __m512i a = _mm512_loadu_si512(bgr), b = _mm512_loadu_si512(bgr + 64),
+                c = _mm512_loadu_si512(bgr + 128);
+  constexpr __mmask64 kLowBytes = 0x5555555555555555ull;
+  auto pick = [&](int h, int ch, __m512i x, __m512i y) {
+    const __m512i idx = _mm512_load_si512(kWidenIndices.of[h][ch]);
+    return V16{_mm512_maskz_permutex2var_epi8(kLowBytes, x, idx, y)};
+  };
+  lo = pixels(d16, pick(0, 0, a, b), pick(0, 1, a, b), pick(0, 2, a, b));
+  hi = pixels(d16, pick(1, 0, b, c), pick(1, 1, b, c), pick(1, 2, b, c));
+}
+#endif
+
 /// One vector of bytes' worth of pixels from `bgr` (Lanes(d8), at most 64): pixel i's test at
 /// bit i. The bytes are loaded whole, each half widened to 16-bit lanes; bound kFirst alone
 /// first, the rest only when some pixel passes it.
 template <int kFirst, class D8>
 HWY_INLINE uint64_t classify_step(D8 d8, const uint8_t* HWY_RESTRICT bgr, const ColorBounds& k,
                                   ClassifyTally& tally) {
+#if HWY_TARGET == HWY_SCALAR  // one lane: no halves
   hn::Vec<D8> b, g, r;
   hn::LoadInterleaved3(d8, bgr, b, g, r);
-#if HWY_TARGET == HWY_SCALAR  // one lane: no halves
   const hn::Rebind<uint16_t, D8> d16;
   const auto p = pixels(d16, hn::PromoteTo(d16, b), hn::PromoteTo(d16, g), hn::PromoteTo(d16, r));
   (void)tally;
   return mask_bits(d16, object_lanes(d16, p, k));
 #else
-  const hn::Half<D8> dh;
-  const hn::Rebind<uint16_t, decltype(dh)> d16;
+  const hn::Rebind<uint16_t, hn::Half<D8>> d16;
   const hn::RebindToSigned<decltype(d16)> di;
-  const auto lo =
-      pixels(d16, hn::PromoteTo(d16, hn::LowerHalf(dh, b)),
-             hn::PromoteTo(d16, hn::LowerHalf(dh, g)), hn::PromoteTo(d16, hn::LowerHalf(dh, r)));
-  const auto hi =
-      pixels(d16, hn::PromoteTo(d16, hn::UpperHalf(dh, b)),
-             hn::PromoteTo(d16, hn::UpperHalf(dh, g)), hn::PromoteTo(d16, hn::UpperHalf(dh, r)));
+  Pixels<hn::Vec<decltype(d16)>> lo, hi;
+  widened(d8, bgr, lo, hi);
   if (hn::AllTrue(di, hn::And(fails<kFirst>(d16, lo, k), fails<kFirst>(d16, hi, k)))) {
     ++tally.skipped;
     return 0;
