@@ -63,6 +63,8 @@ int multicast_socket(uint16_t port) {
   setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &on, sizeof on);
   setsockopt(fd, SOL_SOCKET, SO_TIMESTAMP, &on, sizeof on);
   setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &buffer, sizeof buffer);
+  const timeval patience{2, 0};  // a lost datagram ends the run rather than blocking it forever
+  setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &patience, sizeof patience);
   sockaddr_in at{};
   at.sin_family = AF_INET, at.sin_port = htons(port), at.sin_addr.s_addr = htonl(INADDR_ANY);
   ip_mreq join{};
