@@ -3,7 +3,9 @@
 //   - a UDP multicast socket read by a thread blocked in recvmsg (SO_TIMESTAMP, as LCM stamps
 //     recv_utime);
 //   - LCM 1.3.1's UDP multicast provider, a handler that only reads rbuf->recv_utime: LCM's
-//     receive thread, its pipe to the thread in lcm_handle, the dispatch.
+//     receive thread, its pipe to the thread in lcm_handle, the dispatch;
+//   - sg::Bus::subscribe_direct, as sg-vision reads its camera channels: the bus's own socket on
+//     the group, read in the thread that spins, an empty handler.
 // sg-vision's "of which LCM's delivery" is the second with a real handler around it; a p99 here
 // above sg-vision's goal (1.5 ms) is the platform's, not the program's.
 //
@@ -26,6 +28,7 @@
 #include <thread>
 #include <vector>
 
+#include "common/bus.hpp"
 #include "common/clock.hpp"
 #include "common/latency_record.hpp"
 #include "common/realtime.hpp"
@@ -140,6 +143,26 @@ sg::LatencyRecord lcm_floor(const Settings& s) {
   return latency;
 }
 
+/// sg::Bus::subscribe_direct (sg-vision's camera channels): the bus's own socket read in the
+/// thread that calls spin(), LCM's receive thread running beside it; the handler does nothing
+/// else. The product's path, with the raw bytes' decoding as the only work.
+sg::LatencyRecord direct_floor(const Settings& s) {
+  sg::Bus rx(s.url), tx(s.url);
+  sg::LatencyRecord latency;
+  rx.subscribe_direct_raw("DELIVERY_FLOOR", [&](const sg::RawMessage& m) {
+    latency.add(sg::now_utime() - m.info.recv_utime);
+  });
+  const std::vector<uint8_t> payload(static_cast<size_t>(s.size), 'x');
+  std::thread sender = paced(s, [&](int) {
+    tx.publish_raw("DELIVERY_FLOOR", payload.data(), static_cast<int>(payload.size()));
+  });
+  const int64_t end = sg::now_utime() + static_cast<int64_t>((s.count / s.rate + 2) * 1e6);
+  rx.spin(
+      [&] { return latency.count() < static_cast<uint64_t>(s.count) && sg::now_utime() < end; });
+  sender.join();
+  return latency;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -164,6 +187,7 @@ int main(int argc, char** argv) {
         realtime ? ("SCHED_FIFO " + std::to_string(realtime)).c_str() : "the ordinary scheduler");
     std::printf("  UDP socket, blocked reader:  %s\n", socket_floor(s).summary().c_str());
     std::printf("  LCM, empty handler:          %s\n", lcm_floor(s).summary().c_str());
+    std::printf("  sg::Bus, read directly:      %s\n", direct_floor(s).summary().c_str());
   } catch (const std::exception& e) {
     std::fprintf(stderr, "delivery_floor: %s\n", e.what());
     return 1;

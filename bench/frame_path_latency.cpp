@@ -3,8 +3,10 @@
 // host) to sg-vision and sg-predictor, started as processes; this program times OBJECT_POSITION
 // and OBJECT_TRAJECTORY as they arrive (their receive time less the frames' utime) and reads
 // sg-vision's own figure, second image received -> OBJECT_POSITION published, from its summary.
-// Three runs: JPEG with only the search windows decoded (vision.decode: region, the default),
-// JPEG decoded whole (the baseline), raw BGR8. The frames are the simulated lab's, rendered and
+// Four runs: JPEG with only the search windows decoded (vision.decode: region, the default) and
+// the camera channels read on sg-vision's own socket (vision.camera_read: direct, the default);
+// the same read through LCM's subscription (the baseline for the direct read); JPEG decoded
+// whole (the baseline for the windows); raw BGR8. The frames are the simulated lab's, rendered and
 // encoded before the run (sg-camera-sim's encoder), so rendering is not timed.
 //
 //   scripts/multicast.sh run build/bin/frame_path_latency [--pairs 300] [--rate 20]
@@ -109,6 +111,7 @@ struct Run {
   std::string vision_own;       ///< sg-vision's summary line
   std::string vision_delivery;  ///< ... the part of it before the image's handler (LCM)
   std::string vision_handler;   ///< ... and the part of it in the image's handler
+  std::string worker;           ///< who decoded the pairs' first images
 };
 
 /// Waits until both processes announce themselves on PROCESS_STATUS.
@@ -128,7 +131,7 @@ struct RunSettings {
 
 /// One run: the two programs, `pairs` frames at `rate` Hz, what arrived.
 void run(const RunSettings& rs, const std::vector<std::array<image_t, 2>>& frames,
-         const std::string& decode, Run& out) {
+         const std::string& decode, const std::string& camera_read, Run& out) {
   const std::string &url = rs.url, &dir = rs.dir;
   const int pairs = rs.pairs;
   const double rate = rs.rate;
@@ -144,11 +147,11 @@ void run(const RunSettings& rs, const std::vector<std::array<image_t, 2>>& frame
                                            [&](const auto& m, const auto& info) {
                                              out.trajectory.add(info.recv_utime - m.source_utime);
                                            });
-  Program vision(
-      "sg-vision",
-      {"--calibration", dir + "/cams.yaml", "--decode", decode, "--lcm-url", url, "--log-level",
-       "warn", "--realtime-priority", std::to_string(rs.realtime_priority)},
-      dir + "/vision.out");
+  Program vision("sg-vision",
+                 {"--calibration", dir + "/cams.yaml", "--decode", decode, "--camera-read",
+                  camera_read, "--lcm-url", url, "--log-level", "warn", "--realtime-priority",
+                  std::to_string(rs.realtime_priority)},
+                 dir + "/vision.out");
   Program predictor("sg-predictor",
                     {"--config", dir + "/predictor.yaml", "--lcm-url", url, "--log-level", "warn"},
                     dir + "/predictor.out");
@@ -181,6 +184,8 @@ void run(const RunSettings& rs, const std::vector<std::array<image_t, 2>>& frame
     out.vision_handler = m[1];
   if (std::regex_search(text, m, std::regex("delivery to the image's handler: ([^\n]*)")))
     out.vision_delivery = m[1];
+  if (std::regex_search(text, m, std::regex("decoded by its worker (\\d+) times, in line (\\d+)")))
+    out.worker = std::string(m[1]) + " by the worker, " + std::string(m[2]) + " in line";
 }
 
 void print(const Run& r) {
@@ -191,8 +196,9 @@ void print(const Run& r) {
               static_cast<unsigned long long>(r.position.count()), ms(r.position, 0.5),
               ms(r.position, 0.99), static_cast<unsigned long long>(r.trajectory.count()),
               ms(r.trajectory, 0.5), ms(r.trajectory, 0.99), r.vision_own.c_str());
-  std::printf("%-22s %58s   of which LCM's delivery: %s\n", "", "", r.vision_delivery.c_str());
+  std::printf("%-22s %58s   of which the delivery:  %s\n", "", "", r.vision_delivery.c_str());
   std::printf("%-22s %58s   of which the handler:    %s\n", "", "", r.vision_handler.c_str());
+  std::printf("%-22s %58s   first images decoded:    %s\n", "", "", r.worker.c_str());
 }
 
 }  // namespace
@@ -215,7 +221,8 @@ int main(int argc, char** argv) {
                  "sg-vision's vision.realtime_priority (SCHED_FIFO, memory locked; 0: off)")
       ->check(CLI::Range(0, 99));
   app.add_flag("--region-only", region_only,
-               "only the JPEG run with the windows decoded (the issue's figure)");
+               "only the JPEG runs with the windows decoded, read directly and through LCM "
+               "(the issue's figure and its baseline)");
   CLI11_PARSE(app, argc, argv);
   try {
     const std::string dir =
@@ -224,14 +231,16 @@ int main(int argc, char** argv) {
     std::ofstream(dir + "/predictor.yaml") << "predictor:\n  period: " << 1.0 / rate << "\n";
     std::printf("rendering and encoding 60 stereo frames...\n");
     const Frames frames = render(dir + "/cams.yaml");
-    std::vector<Run> runs(region_only ? 1 : 3);
+    std::vector<Run> runs(region_only ? 2 : 4);
     runs[0].name = "JPEG, windows decoded";
+    runs[1].name = "... read through LCM";
     const RunSettings rs{url, dir, pairs, rate, realtime};
-    run(rs, frames.jpeg, "region", runs[0]);
+    run(rs, frames.jpeg, "region", "direct", runs[0]);
+    run(rs, frames.jpeg, "region", "lcm", runs[1]);
     if (!region_only) {
-      runs[1].name = "JPEG, whole frames", runs[2].name = "raw BGR8";
-      run(rs, frames.jpeg, "full", runs[1]);
-      run(rs, frames.raw, "region", runs[2]);
+      runs[2].name = "JPEG, whole frames", runs[3].name = "raw BGR8";
+      run(rs, frames.jpeg, "full", "direct", runs[2]);
+      run(rs, frames.raw, "region", "direct", runs[3]);
     }
     std::printf(
         "\n%d pairs at %.0f Hz, one host, sg-vision %s, ms from the frames' publication "

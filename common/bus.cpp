@@ -1,5 +1,7 @@
 #include "common/bus.hpp"
 
+#include <arpa/inet.h>
+#include <poll.h>
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
@@ -10,8 +12,10 @@
 #include <cstring>
 
 #include "common/clock.hpp"
+#include "common/lcm_datagram.hpp"
 #include "common/log_format.hpp"
 #include "common/shutdown.hpp"
+#include "common/udpm_socket.hpp"
 
 namespace sg {
 namespace {
@@ -98,19 +102,23 @@ std::string damage_of_log_url(const std::string& url) {
 
 }  // namespace
 
-/// Called by LCM's C dispatch: nothing may leave it by an exception.
+/// Called by LCM's C dispatch and by the bus's own socket: nothing may leave it by an exception.
 class Bus::RawHandler {
  public:
   RawHandler(Bus& bus, std::function<void(const RawMessage&)> fn) : bus_(bus), fn_(std::move(fn)) {}
   void handleMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel) noexcept {
+    deliver(channel, rbuf->recv_utime, static_cast<const uint8_t*>(rbuf->data), rbuf->data_size);
+  }
+  void deliver(const std::string& channel, int64_t recv_utime, const uint8_t* data,
+               size_t size) noexcept {
     try {
       ++bus_.messages_received_;
       bus_.rates_.received(channel);
       RawMessage raw;
       raw.info.channel = channel;
-      raw.info.recv_utime = rbuf->recv_utime;
-      raw.info.size = static_cast<int32_t>(rbuf->data_size);
-      raw.data = static_cast<const uint8_t*>(rbuf->data);
+      raw.info.recv_utime = recv_utime;
+      raw.info.size = static_cast<int32_t>(size);
+      raw.data = data;
       fn_(raw);
     } catch (const std::exception& e) {
       bus_.report_handler_error(channel, e.what());
@@ -176,9 +184,95 @@ void Bus::subscribe_raw(const std::string& channel_regex,
   }
 }
 
+/// The channels read on the bus's own socket (subscribe_direct).
+struct Bus::Direct {
+  explicit Direct(const UdpmEndpoint& endpoint) : socket(endpoint) {}
+  UdpmSocket socket;
+  LcmDatagramAssembler assembler;
+  std::vector<std::pair<std::string, std::unique_ptr<RawHandler>>> channels;
+
+  RawHandler* handler_of(std::string_view channel) const {
+    for (const auto& [name, handler] : channels)
+      if (name == channel) return handler.get();
+    return nullptr;
+  }
+};
+
+bool Bus::subscribe_direct_raw(const std::string& channel,
+                               std::function<void(const RawMessage&)> handler, int queue) {
+  std::optional<UdpmEndpoint> endpoint;
+  try {
+    endpoint = udpm_endpoint(url_);
+  } catch (const std::invalid_argument& e) {
+    throw BusError(e.what());
+  }
+  if (!endpoint) {
+    subscribe_raw(channel, std::move(handler), queue);
+    return false;
+  }
+  if (channel.empty() || channel.size() > kLcmMaxChannel)
+    throw BusError("cannot read channel '" + channel + "' directly: not an LCM channel name");
+  try {
+    if (!direct_) direct_ = std::make_unique<Direct>(*endpoint);
+  } catch (const std::runtime_error& e) {
+    throw BusError(e.what());
+  }
+  if (direct_->handler_of(channel) != nullptr)
+    throw BusError("channel '" + channel + "' is already read directly");
+  direct_->channels.emplace_back(channel, std::make_unique<RawHandler>(*this, std::move(handler)));
+  return true;
+}
+
+namespace {
+/// "10.0.0.5:40123" from UdpmSocket's sender number.
+std::string sender_name(uint64_t sender) {
+  in_addr address{};
+  address.s_addr = htonl(static_cast<uint32_t>(sender >> 16));
+  char text[INET_ADDRSTRLEN] = "?";
+  inet_ntop(AF_INET, &address, text, sizeof text);
+  return std::string(text) + ":" + std::to_string(sender & 0xffff);
+}
+}  // namespace
+
+bool Bus::drain_direct() {
+  bool handled = false;
+  UdpmSocket::Datagram d;
+  // Bounded, so that a flood on the group cannot keep LCM's channels waiting for ever.
+  for (int i = 0; i < 256 && direct_->socket.receive(d); ++i) {
+    const auto wanted = [&](std::string_view c) { return direct_->handler_of(c) != nullptr; };
+    const auto refused = [&](const std::string& why) {
+      note_problem(++decode_errors_, "bus datagram from " + sender_name(d.sender) + ": " + why);
+    };
+    const auto message = direct_->assembler.add(d.sender, d.bytes, d.size, wanted, refused);
+    if (!message) continue;
+    const std::string channel(message->channel);
+    direct_->handler_of(channel)->deliver(channel, d.recv_utime, message->data, message->size);
+    handled = true;
+  }
+  return handled;
+}
+
 bool Bus::handle(std::chrono::milliseconds timeout) {
   tick();
-  const int status = lcm_->handleTimeout(static_cast<int>(timeout.count()));
+  if (!direct_) return handle_lcm(static_cast<int>(timeout.count()));
+  pollfd fds[2] = {{direct_->socket.fd(), POLLIN, 0}, {lcm_->getFileno(), POLLIN, 0}};
+  const int ready = poll(fds, 2, static_cast<int>(timeout.count()));
+  if (ready < 0) {
+    if (errno == EINTR) return false;
+    throw BusError(std::string("waiting for messages failed: ") + std::strerror(errno));
+  }
+  bool handled = false;
+  try {
+    if (fds[0].revents != 0) handled = drain_direct();
+  } catch (const std::runtime_error& e) {
+    throw BusError(e.what());
+  }
+  if (fds[1].revents != 0) handled = handle_lcm(0) || handled;
+  return handled;
+}
+
+bool Bus::handle_lcm(int timeout_ms) {
+  const int status = lcm_->handleTimeout(timeout_ms);
   if (status > 0) return true;
   if (status == 0) return false;
   if (url_.rfind("file://", 0) == 0) {  // LCM 1.3.1 returns -1 at the end of a log

@@ -113,14 +113,47 @@ class Bus {
         queue);
   }
 
+  /// Like subscribe(), for a stream whose latency matters (camera frames, issue 19). On a
+  /// `udpm://` bus the messages on `channel` (a name, not a pattern) are read from a socket of
+  /// the bus's own on its multicast group (sg::UdpmSocket, sg::LcmDatagramAssembler), in the
+  /// thread that calls handle() or spin(): LCM's receive thread and its hand-off to that thread
+  /// (a p99 of 3 ms on the lab's virtual machine, docs/performance.md) are not on their way.
+  /// They are decoded, checked and counted as subscribe()'s are; a datagram that breaks LCM's
+  /// format, and a message that lost a fragment, count as decode errors. No LCM subscription
+  /// may also match `channel` (it would be delivered twice). On another provider (file://,
+  /// memq://) this is subscribe(channel, handler, queue). Returns true when read directly.
+  template <class Message>
+  bool subscribe_direct(const std::string& channel,
+                        std::function<void(const Message&, const ReceiveInfo&)> handler,
+                        int queue = kQueueEverySample) {
+    return subscribe_direct_raw(
+        channel,
+        [this, handler = std::move(handler)](const RawMessage& raw) {
+          Message message{};
+          if (DecodeResult r = safe_decode(raw.data, raw.info.size, message); !r) {
+            report_decode_error(raw.info, r.reason);
+            return;
+          }
+          handler(message, raw.info);
+        },
+        queue);
+  }
+
+  /// subscribe_direct() for undecoded messages.
+  bool subscribe_direct_raw(const std::string& channel,
+                            std::function<void(const RawMessage&)> handler,
+                            int queue = kQueueEverySample);
+
   /// Calls `handler` with every message on matching channels, undecoded. What it throws is
   /// caught and counted like a typed handler's. LCM holds up to `queue` of them while the
   /// handler is busy.
   void subscribe_raw(const std::string& channel_regex,
                      std::function<void(const RawMessage&)> handler, int queue = kQueueEverySample);
 
-  /// Waits up to `timeout` for one message and dispatches it. Returns true when a message was
-  /// handled, false on time-out (or an interrupting signal); throws BusError when LCM fails,
+  /// Waits up to `timeout` for one message and dispatches it (with subscribe_direct(): LCM's
+  /// next message and every datagram waiting on the bus's own socket). Returns true when a
+  /// message was handled, false on time-out (or an interrupting signal); throws BusError when
+  /// LCM (or the bus's socket) fails,
   /// and, on a `file://` URL, returns false at the end of the log (see end_of_log()).
   bool handle(std::chrono::milliseconds timeout);
 
@@ -176,6 +209,10 @@ class Bus {
 
  private:
   class RawHandler;
+  struct Direct;
+  /// Reads what waits on the bus's own socket; true when a message was dispatched.
+  bool drain_direct();
+  bool handle_lcm(int timeout_ms);
   void report_decode_error(const ReceiveInfo& info, const std::string& why);
   void report_handler_error(const std::string& channel, const std::string& what);
   /// Logs the first ten problems of a kind, then one in a thousand: a wrong publisher must not
@@ -185,6 +222,7 @@ class Bus {
   std::string url_;
   std::unique_ptr<lcm::LCM> lcm_;
   std::vector<std::unique_ptr<RawHandler>> handlers_;
+  std::unique_ptr<Direct> direct_;  // with subscribe_direct() on a udpm:// bus
   std::vector<uint8_t> buffer_;
   uint64_t messages_received_ = 0;
   uint64_t decode_errors_ = 0;

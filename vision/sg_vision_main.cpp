@@ -26,6 +26,7 @@
 #include "common/shutdown.hpp"
 #include "vision/blob_tracker.hpp"
 #include "vision/calibration_file.hpp"
+#include "vision/decode_worker.hpp"
 #include "vision/frame_decoder.hpp"
 #include "vision/image_folder.hpp"
 #include "vision/image_message.hpp"
@@ -104,32 +105,35 @@ class StereoVision {
   bool publish_images_;
 };
 
-/// Stereo pairs from CAMERA_LEFT and CAMERA_RIGHT: paired as messages, then each decoded where
-/// its tracker will look (frame_decoder.hpp); times each pair from the second image's arrival
-/// to OBJECT_POSITION published.
+/// Stereo pairs from CAMERA_LEFT and CAMERA_RIGHT: paired as messages, each decoded where its
+/// tracker will look (frame_decoder.hpp); the pair's first image on its camera's DecodeWorker as
+/// it arrives, the second in line when it completes the pair, so the two decode at once. Times
+/// each pair from the second image's arrival to OBJECT_POSITION published.
 class BusFrames {
  public:
+  using Message = std::shared_ptr<const image_t>;
+
   BusFrames(StereoVision& vision, const Options& o, sg::vision::FrameDecoder::Mode mode)
       : vision_(vision),
         pairer_(std::llround(o.pair_tolerance_ms * 1000)),
-        decoders_{sg::vision::FrameDecoder(mode), sg::vision::FrameDecoder(mode)} {}
+        workers_{sg::vision::DecodeWorker(mode), sg::vision::DecodeWorker(mode)} {}
 
   void on_image(const image_t& m, const sg::ReceiveInfo& info) {
     const int64_t start = sg::now_utime();
-    const int side = info.channel == "CAMERA_LEFT" ? 0 : 1;
+    const size_t side = info.channel == "CAMERA_LEFT" ? 0 : 1;
     if (const std::string e = sg::vision::image_message_error(m); !e.empty()) return drop(info, e);
-    auto pair = pairer_.add(side, m.utime, m);
-    if (!pair) return;
-    const image_t* messages[2] = {&pair->first, &pair->second};
+    auto message = std::make_shared<const image_t>(m);
+    auto pair = pairer_.add(static_cast<int>(side), m.utime, message);
+    if (!pair) return workers_[side].post(std::move(message), window(side, m));
+    const Message messages[2] = {pair->first, pair->second};
     const cv::Mat* frames[2];
-    for (size_t i = 0; i < 2; ++i) {
-      std::string error;
-      const cv::Size size(messages[i]->width, messages[i]->height);
-      frames[i] = decoders_[i].decode(*messages[i], vision_.next_window(i, size), &error);
-      if (!frames[i]) return drop(info, error);
-    }
+    std::string error;
+    frames[side] = workers_[side].decode(messages[side], window(side, m), &error);
+    if (!frames[side]) return drop(info, error);
+    if (!(frames[1 - side] = collect(1 - side, messages[1 - side], &error)))
+      return drop(info, error);
     const int64_t published =
-        vision_.process(*frames[0], *frames[1], pair->first.frame_number, pair->first.utime);
+        vision_.process(*frames[0], *frames[1], pair->first->frame_number, pair->first->utime);
     if (published != 0) {  // the stopwatch stops at OBJECT_POSITION, not at the blobs after it
       pair_to_position_.add(published - info.recv_utime);
       delivery_.add(start - info.recv_utime);
@@ -139,13 +143,22 @@ class BusFrames {
   }
 
   int64_t pairs() const { return pairs_; }
+  void set_read_directly(bool direct) { read_directly_ = direct; }
   void report(uint64_t bus_errors) const {
     vision_.report(pairer_.unmatched(), bad_ + bus_errors);
     std::printf("second image received -> OBJECT_POSITION published: %s (decode: %s)\n",
                 pair_to_position_.summary().c_str(),
-                decoders_[0].mode() == sg::vision::FrameDecoder::Mode::kRegion ? "region" : "full");
-    std::printf("  of which LCM's delivery to the image's handler: %s\n",
+                workers_[0].decoder().mode() == sg::vision::FrameDecoder::Mode::kRegion ? "region"
+                                                                                        : "full");
+    std::printf("  of which the delivery to the image's handler: %s\n",
                 delivery_.summary().c_str());
+    std::printf(
+        "  (the camera channels read %s; the first image of a pair decoded by its worker "
+        "%llu times, in line %llu times)\n",
+        read_directly_ ? "directly, on sg-vision's own socket on the bus's group"
+                       : "through LCM's subscription",
+        static_cast<unsigned long long>(workers_[0].by_worker() + workers_[1].by_worker()),
+        static_cast<unsigned long long>(workers_[0].by_caller() + workers_[1].by_caller()));
     std::printf("  of which in the image's handler (decode, track, publish): %s\n",
                 handling_.summary().c_str());
   }
@@ -156,20 +169,47 @@ class BusFrames {
       spdlog::warn("{}: dropped an image: {} ({} so far)", info.channel, error, bad_);
   }
 
+  cv::Rect window(size_t side, const image_t& m) const {
+    return vision_.next_window(side, cv::Size(m.width, m.height));
+  }
+
+  /// The waiting image's frame from its worker; decoded again here when the worker's is another
+  /// message's, or when the tracker now looks beyond what was decoded (a pair processed since).
+  const cv::Mat* collect(size_t side, const Message& message, std::string* error) {
+    sg::vision::DecodeWorker& worker = workers_[side];
+    const cv::Mat* frame = worker.collect(error);
+    const cv::Size size(message->width, message->height);
+    const cv::Rect want = window(side, *message);
+    const cv::Rect need = want.empty() ? cv::Rect({}, size) : want;
+    if (frame && worker.message() == message && (need & worker.decoder().decoded()) == need)
+      return frame;
+    return worker.decode(message, want, error);
+  }
+
   StereoVision& vision_;
-  sg::vision::StereoPairer<image_t> pairer_;
-  sg::vision::FrameDecoder decoders_[2];
+  sg::vision::StereoPairer<Message> pairer_;
+  sg::vision::DecodeWorker workers_[2];
   sg::LatencyRecord pair_to_position_, delivery_, handling_;
   uint64_t bad_ = 0;
   int64_t pairs_ = 0;
+  bool read_directly_ = false;
 };
 
 int run_lcm(sg::Bus& bus, StereoVision& vision, const Options& o,
-            sg::vision::FrameDecoder::Mode mode) {
-  BusFrames frames(vision, o, mode);
+            const sg::vision::VisionSettings& settings) {
+  BusFrames frames(vision, o,
+                   settings.decode == "full" ? sg::vision::FrameDecoder::Mode::kFull
+                                             : sg::vision::FrameDecoder::Mode::kRegion);
   auto on_image = [&](const image_t& m, const sg::ReceiveInfo& info) { frames.on_image(m, info); };
-  bus.subscribe<image_t>("CAMERA_LEFT", on_image, sg::kQueueFrames);
-  bus.subscribe<image_t>("CAMERA_RIGHT", on_image, sg::kQueueFrames);
+  bool direct = false;
+  if (settings.camera_read == "direct") {  // this thread, not LCM's receive thread (issue 19)
+    direct = bus.subscribe_direct<image_t>("CAMERA_LEFT", on_image, sg::kQueueFrames);
+    direct = bus.subscribe_direct<image_t>("CAMERA_RIGHT", on_image, sg::kQueueFrames) && direct;
+  } else {
+    bus.subscribe<image_t>("CAMERA_LEFT", on_image, sg::kQueueFrames);
+    bus.subscribe<image_t>("CAMERA_RIGHT", on_image, sg::kQueueFrames);
+  }
+  frames.set_read_directly(direct);
   bus.announce("sg-vision");  // after subscribing: the first PROCESS_STATUS says it listens
   spdlog::info("waiting for CAMERA_LEFT and CAMERA_RIGHT");
   bus.spin([&] { return o.max_frames == 0 || frames.pairs() < o.max_frames; });
@@ -292,6 +332,7 @@ int main(int argc, char** argv) {
   sg::add_common_options(app, common);
   const auto keys = sg::declared_keys(sg::vision::read_vision_settings);
   common.flags.add(app, "--decode", "vision.decode", keys);
+  common.flags.add(app, "--camera-read", "vision.camera_read", keys);
   common.flags.add(app, "--realtime-priority", "vision.realtime_priority", keys);
   Options o;
   app.add_option("--source", o.source, "lcm (CAMERA_LEFT/RIGHT), video, images or v4l2")
@@ -336,8 +377,6 @@ int main(int argc, char** argv) {
                               ? cv::Size(calibration->left.width(), calibration->left.height())
                               : cv::Size(o.width, o.height);
     StereoVision vision(bus, settings, size, calibration, o.publish_images);
-    const auto mode = settings.decode == "full" ? sg::vision::FrameDecoder::Mode::kFull
-                                                : sg::vision::FrameDecoder::Mode::kRegion;
-    return o.source == "lcm" ? run_lcm(bus, vision, o, mode) : run_frames(vision, o);
+    return o.source == "lcm" ? run_lcm(bus, vision, o, settings) : run_frames(vision, o);
   });
 }

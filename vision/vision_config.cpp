@@ -22,6 +22,8 @@ VisionSettings read_vision_settings(const Config& config) {
   c.text("calibration", s.calibration, "stereo calibration file (then OBJECT_POSITION too)");
   c.choice("decode", s.decode, {"region", "full"},
            "JPEGs: decode only the search windows while tracking (region), or whole (full)");
+  c.choice("camera_read", s.camera_read, {"direct", "lcm"},
+           "udpm: read the camera channels on our own socket (direct) or through LCM (lcm)");
   c.number("realtime_priority", s.realtime_priority, Range::closed(0, 99),
            "SCHED_FIFO priority with memory locked (needs CAP_SYS_NICE; 0: off)");
   band(c, "r_range", k.r_min, k.r_max, "normalized r = R/(R+G+B) of the ball (eq. 7)");

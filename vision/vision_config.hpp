@@ -16,6 +16,10 @@ struct VisionSettings {
   /// JPEGs from the bus: "region" decodes only the search windows while tracking
   /// (frame_decoder.hpp), "full" every frame whole (the baseline).
   std::string decode = "region";
+  /// CAMERA_LEFT and CAMERA_RIGHT on a udpm:// bus: "direct" reads them on sg-vision's own
+  /// socket on the bus's group, in the thread that tracks (Bus::subscribe_direct, issue 19);
+  /// "lcm" through LCM's subscription and receive thread, as every other channel.
+  std::string camera_read = "direct";
   /// SCHED_FIFO priority for sg-vision and its LCM thread, with its memory locked
   /// (common/realtime.hpp); 0: the ordinary scheduler.
   int realtime_priority = 0;

@@ -2,12 +2,16 @@
 
 #include "common/bus.hpp"
 
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <thread>
 
+#include "common/clock.hpp"
 #include "common/message_types.hpp"
 #include "common/shutdown.hpp"
 #include "tests/integration/multicast_guard.hpp"
@@ -115,6 +119,100 @@ TEST(Bus, UndecodableMessagesAreCountedAndDropped) {
   while (bus.handle(10ms)) {
   }
   EXPECT_EQ(bus.decode_errors(), 3u);
+  EXPECT_EQ(calls, 1);
+}
+
+stereograsp::image_t make_image(int64_t utime, size_t bytes) {
+  stereograsp::image_t m{};
+  m.utime = utime;
+  m.size = static_cast<int32_t>(bytes);
+  m.data.resize(bytes);
+  for (size_t i = 0; i < bytes; ++i) m.data[i] = static_cast<uint8_t>(i * 7 + utime);
+  return m;
+}
+
+/// Sends `bytes` as one UDP datagram to the test bus on `port` (this host only).
+void send_datagram(int port, const std::vector<uint8_t>& bytes) {
+  const int fd = socket(AF_INET, SOCK_DGRAM, 0);
+  const unsigned char ttl = 0;
+  setsockopt(fd, IPPROTO_IP, IP_MULTICAST_TTL, &ttl, sizeof ttl);
+  sockaddr_in to{};
+  to.sin_family = AF_INET, to.sin_port = htons(static_cast<uint16_t>(port));
+  inet_pton(AF_INET, "239.255.76.67", &to.sin_addr);
+  sendto(fd, bytes.data(), bytes.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to);
+  close(fd);
+}
+
+// A channel read directly arrives whole (a 300 kB image in fragments and a small one) with its
+// channel, size and kernel time, beside a channel LCM delivers, and counts as received.
+TEST(Bus, DirectChannelsArriveBesideLcmsOwn) {
+  ASSERT_TRUE(test::multicast_available(7976));
+  const std::string url = test::test_url(7976) + "&recv_buf_size=4194304";
+  Bus bus(url), sender(url);
+  std::vector<stereograsp::image_t> images;
+  std::vector<ReceiveInfo> infos;
+  int points = 0;
+  EXPECT_TRUE(bus.subscribe_direct<stereograsp::image_t>(
+      "CAMERA_LEFT", [&](const stereograsp::image_t& m, const ReceiveInfo& info) {
+        images.push_back(m);
+        infos.push_back(info);
+      }));
+  bus.subscribe<point3_t>("OBJECT_POSITION",
+                          [&](const point3_t&, const ReceiveInfo&) { ++points; });
+  const int64_t before = now_utime();
+  sender.publish("CAMERA_LEFT", make_image(1, 300000));
+  sender.publish("CAMERA_RIGHT", make_image(2, 300000));  // nobody's: skipped quietly
+  sender.publish("OBJECT_POSITION", make_point(3, 0.5));
+  sender.publish("CAMERA_LEFT", make_image(4, 100));
+  ASSERT_TRUE(
+      test::eventually([&] { return (bus.handle(20ms), images.size() == 2 && points == 1); }, 10s,
+                       "two images read directly and a point from LCM"));
+  EXPECT_EQ(images[0].data, make_image(1, 300000).data);
+  EXPECT_EQ(images[1].data, make_image(4, 100).data);
+  EXPECT_EQ(infos[0].channel, "CAMERA_LEFT");
+  EXPECT_EQ(infos[0].size, make_image(1, 300000).getEncodedSize());
+  EXPECT_GE(infos[0].recv_utime, before);
+  EXPECT_LE(infos[0].recv_utime, now_utime());
+  EXPECT_EQ(bus.messages_received(), 3u);
+  EXPECT_EQ(bus.decode_errors(), 0u) << bus.last_problem();
+  EXPECT_THROW(bus.subscribe_direct<stereograsp::image_t>(
+                   "CAMERA_LEFT", [](const stereograsp::image_t&, const ReceiveInfo&) {}),
+               BusError);
+}
+
+// Bytes that are not LCM's, a message of another type and a handler's exception on a channel read
+// directly are each counted with a one-line reason; the next good message is served.
+TEST(Bus, DirectChannelsCountWhatTheyRefuse) {
+  ASSERT_TRUE(test::multicast_available(7977));
+  Bus bus(test::test_url(7977)), sender(test::test_url(7977));
+  int calls = 0;
+  bus.subscribe_direct<stereograsp::image_t>(
+      "CAMERA_LEFT", [&](const stereograsp::image_t& m, const ReceiveInfo&) {
+        ++calls;
+        if (m.utime == 5) throw std::runtime_error("a bad frame");
+      });
+  send_datagram(7977, {'G', 'E', 'T', ' ', '/'});
+  ASSERT_TRUE(test::eventually([&] { return (bus.handle(20ms), bus.decode_errors() == 1); }, 10s,
+                               "the datagram counted"));
+  EXPECT_NE(bus.last_problem().find("not an LCM datagram (magic 0x47455420)"), std::string::npos)
+      << bus.last_problem();
+  EXPECT_EQ(bus.last_problem().rfind("bus datagram from ", 0), 0u) << bus.last_problem();
+  sender.publish("CAMERA_LEFT", make_point(1, 0));  // another type
+  sender.publish("CAMERA_LEFT", make_image(5, 10));
+  sender.publish("CAMERA_LEFT", make_image(6, 10));
+  ASSERT_TRUE(test::eventually([&] { return (bus.handle(20ms), calls == 2); }, 10s, "two images"));
+  EXPECT_EQ(bus.decode_errors(), 2u) << bus.last_problem();
+  EXPECT_EQ(bus.handler_errors(), 1u);
+}
+
+// On a bus that is not udpm:// a direct subscription is LCM's own, and still delivers.
+TEST(Bus, DirectSubscriptionFallsBackToLcmOffUdpm) {
+  Bus bus("memq://");
+  int calls = 0;
+  EXPECT_FALSE(bus.subscribe_direct<point3_t>(
+      "OBJECT_POSITION", [&](const point3_t&, const ReceiveInfo&) { ++calls; }));
+  bus.publish("OBJECT_POSITION", make_point(1, 0));
+  EXPECT_TRUE(bus.handle(100ms));
   EXPECT_EQ(calls, 1);
 }
 

@@ -1,0 +1,83 @@
+#include "vision/decode_worker.hpp"
+
+namespace sg::vision {
+
+DecodeWorker::DecodeWorker(FrameDecoder::Mode mode) : decoder_(mode), thread_([this] { run(); }) {}
+
+DecodeWorker::~DecodeWorker() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  posted_.notify_one();
+  thread_.join();
+}
+
+void DecodeWorker::run_decode() {
+  error_.clear();
+  frame_ = decoder_.decode(*message_, region_, &error_);
+}
+
+void DecodeWorker::run() {
+  for (;;) {
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      posted_.wait(lock, [&] { return stop_ || state_.load() == kPosted; });
+      if (stop_) return;
+    }
+    int expected = kPosted;
+    if (!state_.compare_exchange_strong(expected, kWorking, std::memory_order_acquire))
+      continue;  // the caller took it
+    run_decode();
+    state_.store(kDone, std::memory_order_release);
+  }
+}
+
+const cv::Mat* DecodeWorker::decode(std::shared_ptr<const stereograsp::image_t> message,
+                                    cv::Rect region, std::string* error) {
+  if (state_.load(std::memory_order_acquire) != kIdle) {
+    std::string ignored;
+    collect(&ignored);
+  }
+  message_ = std::move(message);
+  region_ = region;
+  run_decode();
+  if (frame_ == nullptr && error) *error = error_;
+  return frame_;
+}
+
+void DecodeWorker::post(std::shared_ptr<const stereograsp::image_t> message, cv::Rect region) {
+  if (state_.load(std::memory_order_acquire) != kIdle) {
+    std::string ignored;
+    collect(&ignored);  // the decoder is one: the last decode ends before the next begins
+  }
+  message_ = std::move(message);
+  region_ = region;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);  // so the worker cannot miss the change
+    state_.store(kPosted, std::memory_order_release);
+  }
+  posted_.notify_one();
+}
+
+const cv::Mat* DecodeWorker::collect(std::string* error) {
+  int expected = kPosted;
+  if (state_.compare_exchange_strong(expected, kWorking, std::memory_order_acquire)) {
+    run_decode();  // the worker has not begun: in line, as without it
+    ++by_caller_;
+  } else if (expected != kIdle) {  // kIdle: collected already
+    // Under way or done: a decode takes a fraction of a millisecond, so spin (yielding the core)
+    // rather than sleep and wait for a wake-up.
+    while (state_.load(std::memory_order_acquire) != kDone) std::this_thread::yield();
+    ++by_worker_;
+  }
+  if (!message_) {
+    if (error) *error = "nothing was posted";
+    return nullptr;
+  }
+  state_.store(kIdle, std::memory_order_relaxed);
+  if (frame_ == nullptr && error) *error = error_;
+  return frame_;
+}
+
+}  // namespace sg::vision
