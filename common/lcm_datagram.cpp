@@ -117,6 +117,39 @@ struct LcmDatagramAssembler::Assembly {
 
 LcmDatagramAssembler::LcmDatagramAssembler(Limits limits) : limits_(limits) {
   limits_.max_senders = std::max<size_t>(limits_.max_senders, 1);
+  limits_.max_held = std::max(limits_.max_held, limits_.max_message);
+}
+
+size_t LcmDatagramAssembler::held() const {
+  size_t bytes = 0;
+  for (const auto& a : assemblies_) bytes += a->capacity;
+  return bytes;
+}
+
+/// Gives `slot` a buffer of at least `size` bytes within max_held: idle buffers are freed first,
+/// then the least recently fed assemblies dropped.
+void LcmDatagramAssembler::make_room(Assembly& slot, size_t size, const Refused& refused) {
+  const size_t wanted = std::max<size_t>(size, 1);
+  if (slot.capacity >= wanted && slot.capacity <= 4 * wanted + (size_t{1} << 20)) return;
+  slot.buffer.reset(), slot.capacity = 0;
+  while (held() + wanted > limits_.max_held) {
+    Assembly* victim = nullptr;
+    for (auto& a : assemblies_) {
+      if (a.get() == &slot || a->capacity == 0) continue;
+      const bool idle = a->state != Assembly::State::kAssembling;
+      const bool victim_idle = victim && victim->state != Assembly::State::kAssembling;
+      if (!victim || (idle && !victim_idle) ||
+          (idle == victim_idle && a->last_used < victim->last_used))
+        victim = a.get();
+    }
+    if (victim->state == Assembly::State::kAssembling)
+      refused(victim->lost("the buffers held would pass " + std::to_string(limits_.max_held) +
+                           " bytes"));
+    victim->state = Assembly::State::kIdle;
+    victim->buffer.reset(), victim->capacity = 0;
+  }
+  slot.buffer.reset(new uint8_t[wanted]);
+  slot.capacity = wanted;
 }
 LcmDatagramAssembler::~LcmDatagramAssembler() = default;
 
@@ -190,10 +223,7 @@ std::optional<LcmMessage> LcmDatagramAssembler::add(uint64_t sender, const uint8
     a->seqno = d->seqno, a->size = d->message_size, a->filled = 0;
     a->next_fragment = 0, a->fragments = d->fragments;
     a->channel.assign(d->channel);
-    if (a->capacity < a->size || a->capacity > 4 * size_t{a->size} + (size_t{1} << 20)) {
-      a->buffer.reset(new uint8_t[std::max<size_t>(a->size, 1)]);
-      a->capacity = std::max<size_t>(a->size, 1);
-    }
+    make_room(*a, a->size, refused);
   }
   if (a == nullptr) return std::nullopt;  // a fragment of a message not assembled here
   a->last_used = ++clock_;

@@ -21,11 +21,12 @@
 ///
 /// Nothing in a datagram is trusted: a channel name of 1 to 63 bytes (LCM's limit), a fragment
 /// inside its message, a message no larger than Limits::max_message, at most Limits::max_senders
-/// messages in assembly at once (the oldest dropped for a newer sender). A message is complete
+/// messages in assembly at once and Limits::max_held bytes of buffers (the oldest dropped for a
+/// newer message). A message is complete
 /// only when its fragments came in order and covered it exactly, so no byte of it is one that
 /// did not arrive; one that misses a fragment is dropped and reported, as is every datagram that
-/// breaks the format. Memory: at most max_senders buffers of max_message bytes, each committed
-/// only as fragments fill it.
+/// breaks the format. Memory: at most max_held bytes of buffers (80 MiB by default), each
+/// committed only as fragments fill it.
 
 #include <cstddef>
 #include <cstdint>
@@ -73,8 +74,12 @@ class LcmDatagramAssembler {
     /// The largest message assembled: a 4096 x 4096 RGB image_t (safe_decode's bound for its
     /// data, 64 MiB) and its header.
     size_t max_message = (size_t{64} << 20) + 4096;
-    /// Messages in assembly at once, one per sender (LCM's sender never interleaves two).
-    size_t max_senders = 8;
+    /// Messages in assembly at once, one per sender (LCM's sender never interleaves two): a
+    /// stereo rig's two cameras and room for two more; at most 4 x 64 MiB held.
+    size_t max_senders = 4;
+    /// Bytes of buffers held at once, in assembly or kept for the next message: the oldest
+    /// assemblies are dropped for a newer one that would pass it. Not less than max_message.
+    size_t max_held = size_t{80} << 20;
   };
 
   explicit LcmDatagramAssembler(Limits limits);
@@ -94,13 +99,15 @@ class LcmDatagramAssembler {
   std::optional<LcmMessage> add(uint64_t sender, const uint8_t* bytes, size_t size,
                                 const Wanted& wanted, const Refused& refused);
 
-  /// Messages in assembly now (for tests of the bounds).
+  /// Messages in assembly now, and the bytes of buffers held (for tests of the bounds).
   size_t in_assembly() const;
+  size_t held() const;
 
  private:
   struct Assembly;
   Assembly* assembly_of(uint64_t sender);
   Assembly& start(uint64_t sender);
+  void make_room(Assembly& slot, size_t size, const Refused& refused);
   std::optional<LcmMessage> continue_fragment(Assembly& a, const LcmDatagram& d,
                                               const Refused& refused);
 

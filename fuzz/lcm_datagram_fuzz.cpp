@@ -1,12 +1,12 @@
 // Drives LCM's UDP wire format as read without LCM (common/lcm_datagram.hpp, what sg::Bus reads
 // on its own socket for subscribe_direct) with any datagrams from any senders. The input is a
 // sequence of records: a sender byte, a big-endian uint16 length, that many bytes of a datagram
-// (the last record takes what is left). Small bounds (a 4 KiB message, three senders) so that
-// the fuzzer reaches them.
+// (the last record takes what is left). Small bounds (a 4 KiB message, three senders, 6,000
+// bytes held) so that the fuzzer reaches them.
 // Asserts, beyond not crashing and not reading or allocating out of bounds:
 //  - every message that comes out is on a wanted channel and within the bound;
 //  - a short (LC02) datagram on a wanted channel comes out as exactly its payload;
-//  - no more messages are in assembly than the bound on senders;
+//  - no more messages are in assembly than the bound on senders, no more bytes held than its bound;
 //  - every refusal is one non-empty line.
 
 #include <algorithm>
@@ -19,7 +19,7 @@
 
 namespace {
 
-constexpr size_t kMaxMessage = 4096, kMaxSenders = 3;
+constexpr size_t kMaxMessage = 4096, kMaxSenders = 3, kMaxHeld = 6000;
 
 bool wanted(std::string_view channel) { return !channel.empty() && channel[0] == 'C'; }
 
@@ -56,7 +56,8 @@ void feed(sg::LcmDatagramAssembler& assembler, uint64_t sender, const uint8_t* d
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  sg::LcmDatagramAssembler assembler(sg::LcmDatagramAssembler::Limits{kMaxMessage, kMaxSenders});
+  sg::LcmDatagramAssembler assembler(
+      sg::LcmDatagramAssembler::Limits{kMaxMessage, kMaxSenders, kMaxHeld});
   size_t at = 0;
   while (at + 3 <= size) {
     const uint64_t sender = data[at] % 5;

@@ -201,7 +201,7 @@ TEST(LcmDatagram, OtherChannelsAreSkippedQuietly) {
 
 // A message claiming more than the bound is refused before anything is allocated for it.
 TEST(LcmDatagram, AMessageAboveTheBoundIsRefused) {
-  Feeder f(LcmDatagramAssembler::Limits{1000, 8});
+  Feeder f(LcmDatagramAssembler::Limits{1000, 8, 100000});
   f.add(fragment(1, 1001, 0, 0, 2, "CAMERA_LEFT", bytes(10, 1)));
   EXPECT_EQ(f.assembler.in_assembly(), 0u);
   ASSERT_EQ(f.refusals.size(), 1u);
@@ -213,7 +213,7 @@ TEST(LcmDatagram, AMessageAboveTheBoundIsRefused) {
 
 // More senders than the bound: the least recently fed message is dropped, the others complete.
 TEST(LcmDatagram, SendersInAssemblyAreBounded) {
-  Feeder f(LcmDatagramAssembler::Limits{1000, 2});
+  Feeder f(LcmDatagramAssembler::Limits{1000, 2, 100000});
   const std::vector<uint8_t> m = bytes(200, 5);
   for (uint64_t sender = 1; sender <= 3; ++sender)
     f.add(fragment(7, 200, 0, 0, 2, "CAMERA_LEFT", part(m, 0, 100)), sender);
@@ -224,6 +224,32 @@ TEST(LcmDatagram, SendersInAssemblyAreBounded) {
     f.add(fragment(7, 200, 100, 1, 2, "", part(m, 100, 100)), sender);
   EXPECT_EQ(f.messages.size(), 2u) << "senders 2 and 3; sender 1's start was dropped";
   EXPECT_EQ(f.assembler.in_assembly(), 0u);
+}
+
+// Buffers held are bounded: a third sender's message that would pass the bound drops the least
+// recently fed one, and a finished message's buffer is freed before any assembly is dropped.
+TEST(LcmDatagram, BuffersHeldAreBounded) {
+  Feeder f(LcmDatagramAssembler::Limits{1000, 4, 2500});
+  const std::vector<uint8_t> m = bytes(1000, 6);
+  for (uint64_t sender = 1; sender <= 2; ++sender)
+    f.add(fragment(3, 1000, 0, 0, 2, "CAMERA_LEFT", part(m, 0, 500)), sender);
+  EXPECT_EQ(f.assembler.held(), 2000u);
+  f.add(fragment(3, 1000, 500, 1, 2, "", part(m, 500, 500)), 2);  // sender 2's is whole
+  ASSERT_EQ(f.messages.size(), 1u);
+  f.add(fragment(4, 1000, 0, 0, 2, "CAMERA_LEFT", part(m, 0, 500)), 3);  // reuses its buffer
+  EXPECT_TRUE(f.refusals.empty());
+  EXPECT_EQ(f.assembler.held(), 2000u);
+  f.add(fragment(5, 1000, 0, 0, 2, "CAMERA_LEFT", part(m, 0, 500)), 4);
+  ASSERT_EQ(f.refusals.size(), 1u);
+  EXPECT_NE(f.refusals[0].find("message 3 (1000 bytes, 1 of 2 fragments) dropped: the buffers "
+                               "held would pass 2500 bytes"),
+            std::string::npos)
+      << f.refusals[0];
+  EXPECT_LE(f.assembler.held(), 2500u);
+  EXPECT_EQ(f.assembler.in_assembly(), 2u);
+  f.add(fragment(5, 1000, 500, 1, 2, "", part(m, 500, 500)), 4);
+  ASSERT_EQ(f.messages.size(), 2u);
+  EXPECT_TRUE(f.messages[1].second == m);
 }
 
 // A short message on a wanted channel is its payload, pointing into the datagram.
