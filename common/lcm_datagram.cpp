@@ -14,6 +14,22 @@ uint16_t be16(const uint8_t* p) { return static_cast<uint16_t>((p[0] << 8) | p[1
 
 constexpr size_t kShortHeader = 8, kLongHeader = 20;
 
+/// A channel name for a one-line report: LCM's names may hold any byte, so those outside
+/// printable ASCII are written as \xNN.
+std::string printable(std::string_view name) {
+  std::string out;
+  for (const char c : name) {
+    if (c >= 0x20 && c < 0x7f && c != '\\') {
+      out += c;
+    } else {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02x", static_cast<unsigned char>(c));
+      out += hex;
+    }
+  }
+  return out;
+}
+
 /// The NUL-terminated channel name at `p` (at most `left` bytes), and its length with the NUL;
 /// 0 and `why` set when it is not a name LCM sends.
 size_t read_channel(const uint8_t* p, size_t left, std::string_view* channel, std::string* why) {
@@ -109,7 +125,7 @@ struct LcmDatagramAssembler::Assembly {
 
   /// "CAMERA_LEFT: message 17 (921654 bytes) dropped: " + why.
   std::string lost(const std::string& why) const {
-    return channel + ": message " + std::to_string(seqno) + " (" + std::to_string(size) +
+    return printable(channel) + ": message " + std::to_string(seqno) + " (" + std::to_string(size) +
            " bytes, " + std::to_string(next_fragment) + " of " + std::to_string(fragments) +
            " fragments) dropped: " + why;
   }
@@ -211,7 +227,7 @@ std::optional<LcmMessage> LcmDatagramAssembler::add(uint64_t sender, const uint8
   if (d->fragment_no == 0) {
     if (!wanted(d->channel)) return std::nullopt;
     if (d->message_size > limits_.max_message) {
-      refused(std::string(d->channel) + ": a " + std::to_string(d->message_size) +
+      refused(printable(d->channel) + ": a " + std::to_string(d->message_size) +
               "-byte message, above the bound of " + std::to_string(limits_.max_message));
       return std::nullopt;
     }

@@ -252,6 +252,19 @@ TEST(LcmDatagram, BuffersHeldAreBounded) {
   EXPECT_TRUE(f.messages[1].second == m);
 }
 
+// A channel name's bytes outside printable ASCII are written as \xNN: a report stays one line
+// (found by the lcm_datagram fuzz target).
+TEST(LcmDatagram, ReportsStayOneLine) {
+  LcmDatagramAssembler assembler(LcmDatagramAssembler::Limits{100, 4, 1000});
+  std::vector<std::string> refusals;
+  const std::vector<uint8_t> d = fragment(1, 200, 0, 0, 2, "CAM\nERA\\", {1});
+  assembler.add(
+      1, d.data(), d.size(), [](std::string_view) { return true; },
+      [&](const std::string& why) { refusals.push_back(why); });
+  ASSERT_EQ(refusals.size(), 1u);
+  EXPECT_EQ(refusals[0], "CAM\\x0aERA\\x5c: a 200-byte message, above the bound of 100");
+}
+
 // A short message on a wanted channel is its payload, pointing into the datagram.
 TEST(LcmDatagram, AShortMessageIsItsPayload) {
   const std::vector<uint8_t> d = short_datagram(42, "CAMERA_LEFT", {9, 8, 7});
