@@ -220,17 +220,14 @@ std::optional<LcmMessage> LcmDatagramAssembler::add(uint64_t sender, const uint8
     a->state = Assembly::State::kIdle;
     a = nullptr;
   }
-  if (!d->fragment) {
-    if (!wanted(d->channel)) return std::nullopt;
-    return LcmMessage{d->channel, d->data, d->size};
+  if ((!d->fragment || d->fragment_no == 0) && !wanted(d->channel)) return std::nullopt;
+  if ((!d->fragment || d->fragment_no == 0) && d->message_size > limits_.max_message) {
+    refused(printable(d->channel) + ": a " + std::to_string(d->message_size) +
+            "-byte message, above the bound of " + std::to_string(limits_.max_message));
+    return std::nullopt;
   }
+  if (!d->fragment) return LcmMessage{d->channel, d->data, d->size};
   if (d->fragment_no == 0) {
-    if (!wanted(d->channel)) return std::nullopt;
-    if (d->message_size > limits_.max_message) {
-      refused(printable(d->channel) + ": a " + std::to_string(d->message_size) +
-              "-byte message, above the bound of " + std::to_string(limits_.max_message));
-      return std::nullopt;
-    }
     a = &start(sender);
     if (a->state == Assembly::State::kAssembling)
       refused(a->lost("more than " + std::to_string(limits_.max_senders) +

@@ -206,6 +206,10 @@ TEST(LcmDatagram, AMessageAboveTheBoundIsRefused) {
   EXPECT_EQ(f.assembler.in_assembly(), 0u);
   ASSERT_EQ(f.refusals.size(), 1u);
   EXPECT_EQ(f.refusals[0], "CAMERA_LEFT: a 1001-byte message, above the bound of 1000");
+  f.add(short_datagram(2, "CAMERA_LEFT", bytes(1001, 2)));  // one datagram: the same bound
+  ASSERT_EQ(f.refusals.size(), 2u);
+  EXPECT_EQ(f.refusals[1], "CAMERA_LEFT: a 1001-byte message, above the bound of 1000");
+  EXPECT_TRUE(f.messages.empty());
   Feeder g;  // the default bound is 64 MiB and a header: 2^32 - 1 claimed is refused
   g.add(fragment(1, 0xffffffffu, 0, 0, 2, "CAMERA_LEFT", bytes(10, 1)));
   EXPECT_EQ(g.refusals.size(), 1u);
