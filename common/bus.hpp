@@ -100,17 +100,7 @@ class Bus {
   void subscribe(const std::string& channel_regex,
                  std::function<void(const Message&, const ReceiveInfo&)> handler,
                  int queue = kQueueEverySample) {
-    subscribe_raw(
-        channel_regex,
-        [this, handler = std::move(handler)](const RawMessage& raw) {
-          Message message{};
-          if (DecodeResult r = safe_decode(raw.data, raw.info.size, message); !r) {
-            report_decode_error(raw.info, r.reason);
-            return;
-          }
-          handler(message, raw.info);
-        },
-        queue);
+    subscribe_raw(channel_regex, decoding<Message>(std::move(handler)), queue);
   }
 
   /// Like subscribe(), for a stream whose latency matters (camera frames, issue 19). On a
@@ -126,17 +116,7 @@ class Bus {
   bool subscribe_direct(const std::string& channel,
                         std::function<void(const Message&, const ReceiveInfo&)> handler,
                         int queue = kQueueEverySample) {
-    return subscribe_direct_raw(
-        channel,
-        [this, handler = std::move(handler)](const RawMessage& raw) {
-          Message message{};
-          if (DecodeResult r = safe_decode(raw.data, raw.info.size, message); !r) {
-            report_decode_error(raw.info, r.reason);
-            return;
-          }
-          handler(message, raw.info);
-        },
-        queue);
+    return subscribe_direct_raw(channel, decoding<Message>(std::move(handler)), queue);
   }
 
   /// subscribe_direct() for undecoded messages.
@@ -210,6 +190,20 @@ class Bus {
  private:
   class RawHandler;
   struct Direct;
+  /// A raw handler that calls `handler` with the message decoded (sg::safe_decode), or counts
+  /// and logs why it does not decode as Message.
+  template <class Message>
+  std::function<void(const RawMessage&)> decoding(
+      std::function<void(const Message&, const ReceiveInfo&)> handler) {
+    return [this, handler = std::move(handler)](const RawMessage& raw) {
+      Message message{};
+      if (DecodeResult r = safe_decode(raw.data, raw.info.size, message); !r) {
+        report_decode_error(raw.info, r.reason);
+        return;
+      }
+      handler(message, raw.info);
+    };
+  }
   /// Reads what waits on the bus's own socket; true when a message was dispatched.
   bool drain_direct();
   bool handle_lcm(int timeout_ms);
