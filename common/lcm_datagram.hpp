@@ -25,8 +25,9 @@
 /// newer message). A message is complete
 /// only when its fragments came in order and covered it exactly, so no byte of it is one that
 /// did not arrive; one that misses a fragment is dropped and reported, as is every datagram that
-/// breaks the format. Memory: at most max_held bytes of buffers (80 MiB by default), each
-/// committed only as fragments fill it.
+/// breaks the format (a message whose sender falls silent before its last fragment is held until
+/// its slot is wanted, then reported). Memory: at most max_held bytes of buffers (80 MiB by
+/// default), each committed only as fragments fill it.
 
 #include <cstddef>
 #include <cstdint>

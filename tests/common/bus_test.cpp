@@ -2,10 +2,7 @@
 
 #include "common/bus.hpp"
 
-#include <arpa/inet.h>
 #include <gtest/gtest.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -131,18 +128,6 @@ stereograsp::image_t make_image(int64_t utime, size_t bytes) {
   return m;
 }
 
-/// Sends `bytes` as one UDP datagram to the test bus on `port` (this host only).
-void send_datagram(int port, const std::vector<uint8_t>& bytes) {
-  const int fd = socket(AF_INET, SOCK_DGRAM, 0);
-  const unsigned char ttl = 0;
-  setsockopt(fd, IPPROTO_IP, IP_MULTICAST_TTL, &ttl, sizeof ttl);
-  sockaddr_in to{};
-  to.sin_family = AF_INET, to.sin_port = htons(static_cast<uint16_t>(port));
-  inet_pton(AF_INET, "239.255.76.67", &to.sin_addr);
-  sendto(fd, bytes.data(), bytes.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to);
-  close(fd);
-}
-
 // A channel read directly arrives whole (a 300 kB image in fragments and a small one) with its
 // channel, size and kernel time, beside a channel LCM delivers, and counts as received.
 TEST(Bus, DirectChannelsArriveBesideLcmsOwn) {
@@ -191,7 +176,7 @@ TEST(Bus, DirectChannelsCountWhatTheyRefuse) {
         ++calls;
         if (m.utime == 5) throw std::runtime_error("a bad frame");
       });
-  send_datagram(7977, {'G', 'E', 'T', ' ', '/'});
+  test::send_raw_datagrams(7977, {{'G', 'E', 'T', ' ', '/'}});
   ASSERT_TRUE(test::eventually([&] { return (bus.handle(20ms), bus.decode_errors() == 1); }, 10s,
                                "the datagram counted"));
   EXPECT_NE(bus.last_problem().find("not an LCM datagram (magic 0x47455420)"), std::string::npos)

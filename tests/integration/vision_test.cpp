@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -22,7 +23,8 @@ namespace {
 using namespace std::chrono_literals;
 
 // Simulated cameras -> sg-vision -> OBJECT_POSITION within 5 mm of GROUND_TRUTH, every frame,
-// blobs for both cameras; then a malformed image_t is counted and dropped.
+// blobs for both cameras; a malformed image_t and three datagrams that are not LCM's are each
+// counted, said in one line, and dropped.
 TEST(Vision, PositionsFromSimulatedCamerasMatchTheTruth) {
   constexpr int kPort = 7909;
   ASSERT_TRUE(multicast_available(kPort));
@@ -55,6 +57,22 @@ TEST(Vision, PositionsFromSimulatedCamerasMatchTheTruth) {
   bad.size = 100;
   bad.data.assign(100, 7);
   bus.publish("CAMERA_LEFT", bad);
+  // Then bytes LCM would never send, read on sg-vision's own socket (vision.camera_read: direct):
+  // not LCM's at all; a first fragment of CAMERA_LEFT claiming 1 GB; and a CAMERA_LEFT of three
+  // fragments whose second never comes. Each is one decode error; nothing else changes.
+  send_raw_datagrams(kPort, {{'G', 'E', 'T', ' ', '/', '\n'}});
+  const auto fragment = [](uint32_t size, uint32_t offset, uint16_t no, const char* channel) {
+    std::vector<uint8_t> d = {'L', 'C', '0', '3', 0, 0, 0, 9};
+    for (const uint32_t v : {size, offset}) {
+      for (int shift = 24; shift >= 0; shift -= 8) d.push_back(static_cast<uint8_t>(v >> shift));
+    }
+    d.insert(d.end(), {0, static_cast<uint8_t>(no), 0, 3});
+    if (no == 0) d.insert(d.end(), channel, channel + std::strlen(channel) + 1);  // and its NUL
+    d.resize(d.size() + 100, 7);
+    return d;
+  };
+  send_raw_datagrams(kPort, {fragment(1u << 30, 0, 0, "CAMERA_LEFT")});
+  send_raw_datagrams(kPort, {fragment(300, 0, 0, "CAMERA_LEFT"), fragment(300, 200, 2, "")});
   // Every frame counts here: the simulator renders each one, however late (a loaded machine).
   Child sim({program("sg-camera-sim"), "--rate", "10", "--frames", "30", "--max-lag", "0",
              "--lcm-url", url});
@@ -68,8 +86,16 @@ TEST(Vision, PositionsFromSimulatedCamerasMatchTheTruth) {
   EXPECT_NE(v.out.find("processed 30 stereo frames: ball found left 100.0%, right 100.0%"),
             std::string::npos)
       << v.out;
-  EXPECT_NE(v.out.find("1 bad images"), std::string::npos) << v.out;
+  EXPECT_NE(v.out.find("4 bad images"), std::string::npos) << v.out;
   EXPECT_NE(v.err.find("dropped an image"), std::string::npos) << v.err;
+  EXPECT_NE(v.err.find("not an LCM datagram (magic 0x47455420)"), std::string::npos) << v.err;
+  EXPECT_NE(v.err.find("CAMERA_LEFT: a 1073741824-byte message, above the bound"),
+            std::string::npos)
+      << v.err;
+  EXPECT_NE(v.err.find("CAMERA_LEFT: message 9 (300 bytes, 1 of 3 fragments) dropped: fragment 2 "
+                       "came where 1 was due"),
+            std::string::npos)
+      << v.err;
   ASSERT_EQ(measured.size(), 30u);
   EXPECT_EQ(blobs, 60);
   double worst = 0;
