@@ -133,7 +133,7 @@ struct LcmDatagramAssembler::Assembly {
 
 LcmDatagramAssembler::LcmDatagramAssembler(Limits limits) : limits_(limits) {
   limits_.max_senders = std::max<size_t>(limits_.max_senders, 1);
-  limits_.max_held = std::max(limits_.max_held, limits_.max_message);
+  limits_.max_held = std::max({limits_.max_held, limits_.max_message, size_t{1}});  // room for one
 }
 
 size_t LcmDatagramAssembler::held() const {

@@ -77,7 +77,7 @@ std::optional<UdpmEndpoint> udpm_endpoint(const std::string& url) {
   const size_t scheme = given.find("://");
   const std::string provider = scheme == std::string::npos ? given : given.substr(0, scheme);
   if (provider != "udpm") return std::nullopt;
-  const std::string rest = given.substr(scheme + 3);
+  const std::string rest = scheme == std::string::npos ? "" : given.substr(scheme + 3);
   const size_t query = rest.find('?');
   UdpmEndpoint e;
   read_network(rest.substr(0, query), e, given);

@@ -33,12 +33,15 @@ void DecodeWorker::run() {
   }
 }
 
+void DecodeWorker::settle() {
+  if (state_.load(std::memory_order_acquire) == kIdle) return;
+  std::string ignored;
+  collect(&ignored);  // the decoder is one: the last decode ends before the next begins
+}
+
 const cv::Mat* DecodeWorker::decode(std::shared_ptr<const stereograsp::image_t> message,
                                     cv::Rect region, std::string* error) {
-  if (state_.load(std::memory_order_acquire) != kIdle) {
-    std::string ignored;
-    collect(&ignored);
-  }
+  settle();
   message_ = std::move(message);
   region_ = region;
   run_decode();
@@ -47,10 +50,7 @@ const cv::Mat* DecodeWorker::decode(std::shared_ptr<const stereograsp::image_t> 
 }
 
 void DecodeWorker::post(std::shared_ptr<const stereograsp::image_t> message, cv::Rect region) {
-  if (state_.load(std::memory_order_acquire) != kIdle) {
-    std::string ignored;
-    collect(&ignored);  // the decoder is one: the last decode ends before the next begins
-  }
+  settle();
   message_ = std::move(message);
   region_ = region;
   {

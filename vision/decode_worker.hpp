@@ -74,6 +74,7 @@ class DecodeWorker {
   enum State : int { kIdle, kPosted, kWorking, kDone };
   void run();         // the worker thread
   void run_decode();  // the posted message, on whichever thread took it
+  void settle();      // collects (and discards) a decode still posted
 
   FrameDecoder decoder_;
   std::shared_ptr<const stereograsp::image_t> message_;

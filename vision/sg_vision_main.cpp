@@ -174,15 +174,16 @@ class BusFrames {
   }
 
   /// The waiting image's frame from its worker; decoded again here when the worker's is another
-  /// message's, or when the tracker now looks beyond what was decoded (a pair processed since).
+  /// message's, or when the tracker now looks beyond what was decoded (a pair processed since),
+  /// but never again when the message did not decode.
   const cv::Mat* collect(size_t side, const Message& message, std::string* error) {
     sg::vision::DecodeWorker& worker = workers_[side];
     const cv::Mat* frame = worker.collect(error);
     const cv::Size size(message->width, message->height);
     const cv::Rect want = window(side, *message);
     const cv::Rect need = want.empty() ? cv::Rect({}, size) : want;
-    if (frame && worker.message() == message && (need & worker.decoder().decoded()) == need)
-      return frame;
+    if (worker.message() == message && (!frame || (need & worker.decoder().decoded()) == need))
+      return frame;  // decoded where the tracker looks, or not decodable (`error` says why)
     return worker.decode(message, want, error);
   }
 

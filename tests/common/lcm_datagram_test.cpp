@@ -294,6 +294,10 @@ TEST(UdpmEndpoint, ReadsLcmUrls) {
   EXPECT_EQ(d->group, "239.255.76.67");
   EXPECT_EQ(d->port, 7667);
   EXPECT_FALSE(udpm_endpoint("memq://"));
+  EXPECT_FALSE(udpm_endpoint("tcpq"));  // no "://": a provider's name alone
+  const auto bare = udpm_endpoint("udpm");
+  ASSERT_TRUE(bare);
+  EXPECT_EQ(bare->group, "239.255.76.67");
   EXPECT_FALSE(udpm_endpoint("file:///tmp/x.lcm?mode=r"));
   EXPECT_THROW(udpm_endpoint("udpm://239.255.76.67:99999"), std::invalid_argument);
   EXPECT_THROW(udpm_endpoint("udpm://not-an-address:7667"), std::invalid_argument);
