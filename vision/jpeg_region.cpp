@@ -59,6 +59,18 @@ cv::Rect widened(cv::Rect region, cv::Size size, int mx, int my) {
   return {x0, y0, x1 - x0, y1 - y0};
 }
 
+/// A BGR frame of `size` whose rows start 3 bytes past a 32-byte boundary, 3 x (a multiple of 32)
+/// bytes apart. libjpeg-turbo's SIMD colour conversion writes an output row that starts on a 16- or
+/// 32-byte boundary with non-temporal stores (`vmovntdq`, simd/x86_64/jdcolext-avx2.asm), which
+/// bypass the cache: a window's short rows written so cost more than they save, and the tracker
+/// then reads them from memory. A cropped row starts 3 x (a multiple of 8) bytes further: an odd
+/// address, never on such a boundary.
+void allocate_frame(cv::Mat& bgr, cv::Size size) {
+  const int padded = (size.width + 1 + 31) / 32 * 32;  // px
+  const cv::Mat rows(size.height, padded, CV_8UC3);    // OpenCV aligns it to 64 bytes
+  bgr = rows(cv::Rect(1, 0, size.width, size.height));
+}
+
 }  // namespace
 
 struct JpegRegionDecoder::State {
@@ -96,7 +108,7 @@ std::string declared_error(int width, int height, cv::Size size) {
 JpegRegionDecoder::Result JpegRegionDecoder::decode(const uint8_t* data, size_t bytes,
                                                     cv::Size size, cv::Rect region, cv::Mat& bgr) {
   if (data == nullptr || bytes == 0) return {false, {}, "empty JPEG"};
-  if (bgr.type() != CV_8UC3 || bgr.size() != size) bgr.create(size, CV_8UC3);
+  if (bgr.type() != CV_8UC3 || bgr.size() != size) allocate_frame(bgr, size);
   JpegLayout& layout = state_->layout;
   const cv::Rect all(0, 0, size.width, size.height);
   if (!(region & all).empty() && read_layout(data, bytes, layout) && layout.cuttable()) {
@@ -137,9 +149,11 @@ JpegRegionDecoder::Result JpegRegionDecoder::decode_rows(const uint8_t* data, si
   }
   c.out_color_space = JCS_EXT_BGR;
   jpeg_start_decompress(&c);
-  // One iMCU more on every side: the upsampling of the region's edge reads its neighbours.
-  const cv::Rect want =
-      widened(region, size, c.max_h_samp_factor * DCTSIZE, c.max_v_samp_factor * DCTSIZE);
+  // The upsampling of the region's edge reads its neighbours: a margin as for a cut; from the top
+  // of an iMCU row, as skipping rows inside one costs more than converting them.
+  cv::Rect want = widened(region, size, kCutMargin, kCutMargin);
+  const int imcu_rows = c.max_v_samp_factor * DCTSIZE, top = want.y / imcu_rows * imcu_rows;
+  want.height += want.y - top, want.y = top;
   JDIMENSION x = static_cast<JDIMENSION>(want.x), width = static_cast<JDIMENSION>(want.width);
   if (want.width < size.width) jpeg_crop_scanline(&c, &x, &width);  // x moves left to an iMCU
   if (want.y > 0) jpeg_skip_scanlines(&c, static_cast<JDIMENSION>(want.y));

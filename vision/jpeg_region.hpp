@@ -16,9 +16,15 @@
 ///     if (!r.ok) spdlog::warn("dropped: {}", r.error);
 ///     tracker.detect(frame);                                // reads only `window`
 ///
-/// The pixels of `region` are bit for bit those of a whole decode by the same decoder (a test):
-/// the request is widened by one iMCU on every side, so the upsampling's neighbours of the
-/// region's edge pixels are decoded too. Pixels outside the decoded rect keep what they held.
+/// The pixels of `region` are bit for bit those of a whole decode by the same decoder (a test, and
+/// the jpeg_region fuzzer): the request is widened by 4 px on every side (then to the iMCU row
+/// above and the iMCU column to the left), so the upsampling's neighbours of the region's edge
+/// pixels, one chroma sample away, are decoded too. Pixels outside the decoded rect keep what they
+/// held.
+///
+/// A frame the decoder allocates has its rows off every 16-byte boundary: libjpeg-turbo's SIMD
+/// colour conversion writes a row that starts on one with non-temporal stores, past the cache,
+/// which made a window's decode up to 2x slower, and the tracking step after it 2x (vision_bench).
 ///
 /// Hostile input: the JPEG's own header must declare the size the caller expects (checked before
 /// anything is allocated); a progressive JPEG may have at most kMaxScans scans (a crafted one
@@ -51,9 +57,9 @@ class JpegRegionDecoder {
   JpegRegionDecoder& operator=(const JpegRegionDecoder&) = delete;
 
   /// Decodes the part of the JPEG `data` covering `region` (clipped to the image; an empty region
-  /// decodes the whole image) into `bgr`, which becomes a CV_8UC3 image of `size` if it is not one
-  /// already. Fails, leaving `bgr`'s pixels undefined where decoded, when the JPEG is not one
-  /// libjpeg-turbo decodes or declares another size than `size`.
+  /// decodes the whole image) into `bgr`, which becomes a CV_8UC3 image of `size` (allocated as
+  /// above) if it is not one already. Fails, leaving `bgr`'s pixels undefined where decoded, when
+  /// the JPEG is not one libjpeg-turbo decodes or declares another size than `size`.
   Result decode(const uint8_t* data, size_t bytes, cv::Size size, cv::Rect region, cv::Mat& bgr);
 
   /// Warnings libjpeg-turbo gave over all decodes (corrupt data it decoded through).

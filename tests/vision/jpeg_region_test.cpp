@@ -167,8 +167,9 @@ TEST(JpegRegionDecoder, WholeDecodeIsOpenCvs) {
   }
 }
 
-// A search window of a 640x480 frame decodes the window and at most one iMCU (16 px) more on
-// each side, plus the alignment to an iMCU column; the pixels outside keep what they held.
+// A search window of a 640x480 frame decodes the window and 4 px more on each side (the reach of
+// the upsampling of its edge), from the top of its first iMCU row and the left of its first iMCU
+// column; the pixels outside keep what they held.
 TEST(JpegRegionDecoder, OnlyTheRegionsIMCUsAreWritten) {
   const Jpeg& j = jpegs()[2];  // 4:2:0: iMCUs of 16 x 16
   JpegRegionDecoder decoder;
@@ -177,8 +178,10 @@ TEST(JpegRegionDecoder, OnlyTheRegionsIMCUsAreWritten) {
   const auto r = decoder.decode(j.bytes.data(), j.bytes.size(), j.size, window, bgr);
   ASSERT_TRUE(r.ok) << r.error;
   EXPECT_EQ(r.decoded.x % 16, 0);
-  EXPECT_LE(r.decoded.width, window.width + 2 * 16 + 16);
-  EXPECT_EQ(r.decoded.height, window.height + 2 * 16);
+  EXPECT_EQ(r.decoded.x, 272);  // 277 - 4, down to the iMCU column at 16 x 17
+  EXPECT_EQ(r.decoded.br().x, 277 + 80 + 4);
+  EXPECT_EQ(r.decoded.y, 144);  // 163 - 4, up to the iMCU row at 16 x 9
+  EXPECT_EQ(r.decoded.br().y, 163 + 80 + 4);
   cv::Mat outside = bgr.clone();
   outside(r.decoded).setTo(cv::Scalar(77, 77, 77));
   EXPECT_EQ(cv::countNonZero(outside.reshape(1) != 77), 0);
@@ -219,6 +222,19 @@ TEST(JpegRegionDecoder, ProgressiveWithTooManyScansIsRefused) {
   const auto r = decoder.decode(bytes.data(), bytes.size(), {96, 72}, {}, bgr);
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.error, "JPEG does not decode: progressive JPEG with more than 50 scans");
+}
+
+// A frame the decoder allocates has no row, nor any iMCU column's start in a row, on a 16-byte
+// boundary, where libjpeg-turbo's SIMD colour conversion would write it past the cache.
+TEST(JpegRegionDecoder, AllocatedRowsAreNeverOnA16ByteBoundary) {
+  const Jpeg& j = jpegs()[2];
+  JpegRegionDecoder decoder;
+  cv::Mat bgr;
+  ASSERT_TRUE(decoder.decode(j.bytes.data(), j.bytes.size(), j.size, {300, 200, 40, 40}, bgr).ok);
+  ASSERT_EQ(bgr.size(), j.size);
+  for (int y = 0; y < bgr.rows; ++y)
+    for (int x = 0; x < bgr.cols; x += 8)
+      ASSERT_NE(reinterpret_cast<uintptr_t>(bgr.ptr<uint8_t>(y, x)) % 16, 0u) << x << ", " << y;
 }
 
 }  // namespace
