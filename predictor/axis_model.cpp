@@ -31,28 +31,40 @@ class BurgAxis : public AxisModel {
   std::vector<double> forecast(int horizon) const override {
     std::vector<double> out;
     if (history_.empty()) return out;
-    const double m = mean_;
-    std::vector<double> s;  // centred history, then the forecasts appended
-    // The last p samples (at least the newest: without coefficients yet, the forecast holds it).
-    const size_t keep = std::max<size_t>(a_.size(), 1);
-    const size_t start = history_.size() > keep ? history_.size() - keep : 0;
-    for (size_t i = start; i < history_.size(); ++i) s.push_back(history_[i] - m);
+    std::vector<double> s = forecast_start(horizon);  // centred, then the forecasts appended
+    out.reserve(static_cast<size_t>(horizon));
     for (int h = 0; h < horizon; ++h) {
       const double next =
           a_.empty() ? s.back() : predict_next(a_, s.data(), static_cast<int>(s.size()));
       s.push_back(next);
-      out.push_back(next + m);
+      out.push_back(next + mean_);
     }
     return out;
   }
 
+  /// The centred samples a forecast of `horizon` starts from: the last p (at least the newest:
+  /// without coefficients yet, the forecast holds it), with room for the forecast.
+  std::vector<double> forecast_start(int horizon) const {
+    std::vector<double> s;
+    const size_t keep = std::max<size_t>(a_.size(), 1);
+    const size_t start = history_.size() > keep ? history_.size() - keep : 0;
+    s.reserve(history_.size() - start + static_cast<size_t>(std::max(horizon, 0)));
+    for (size_t i = start; i < history_.size(); ++i) s.push_back(history_[i] - mean_);
+    return s;
+  }
+
   /// Appends a sample; a measurement also updates the mean (the coefficients: estimate()).
   void add(double value, bool measured) {
-    history_.push_back(value);
-    if (static_cast<int>(history_.size()) > p_.window) history_.pop_front();
+    append(value);
     // The mean and the coefficients are learnt from measurements only: through an occlusion they
     // stay as they were, and the fed-back samples continue the forecast made at its start.
     if (measured) mean_ = window_mean();
+  }
+
+  /// add() without the mean: BurgTrajectory sums its three windows in one pass.
+  void append(double value) {
+    history_.push_back(value);
+    if (static_cast<int>(history_.size()) > p_.window) history_.pop_front();
   }
 
   void replace(const std::vector<double>& values) {
@@ -79,14 +91,21 @@ class BurgAxis : public AxisModel {
   }
   void set_coefficients(std::vector<double> a) { a_ = std::move(a); }
   int order() const { return p_.order; }
+  const std::vector<double>& coefficients() const { return a_; }
+  double mean() const { return mean_; }
+  size_t size() const { return history_.size(); }
+  bool removes_mean() const { return p_.remove_mean; }
+  const std::deque<double>& history() const { return history_; }
+  void set_mean(double m) { mean_ = m; }
 
- private:
+  /// The window's mean (0 when the mean is not removed): its samples summed in order from 0.
   double window_mean() const {
     if (!p_.remove_mean || history_.empty()) return 0.0;
     return std::accumulate(history_.begin(), history_.end(), 0.0) /
            static_cast<double>(history_.size());
   }
 
+ private:
   BurgParams p_;
   std::vector<double> a_;
   std::deque<double> history_;
@@ -102,18 +121,66 @@ class BurgTrajectory : public TrajectoryModel {
       : axes_{BurgAxis(p[0]), BurgAxis(p[1]), BurgAxis(p[2])} {}
 
   void push(const std::array<double, 3>& value, bool measured) override {
-    for (size_t i = 0; i < 3; ++i) axes_[i].add(value[i], measured);
-    if (measured) estimate();
+    for (size_t i = 0; i < 3; ++i) axes_[i].append(value[i]);
+    if (measured) {
+      update_means();
+      estimate();
+    }
   }
   void replace_newest(const std::array<std::vector<double>, 3>& values) override {
     for (size_t i = 0; i < 3; ++i) axes_[i].replace(values[i]);
     estimate();
   }
+
+  /// The three axes' forecasts (eq. 27) in one loop when their orders agree, each axis's sum in
+  /// BurgAxis::forecast's order: three independent chains of additions where one axis has one.
   std::array<std::vector<double>, 3> forecast(int horizon) const override {
-    return {axes_[0].forecast(horizon), axes_[1].forecast(horizon), axes_[2].forecast(horizon)};
+    const size_t p = axes_[0].coefficients().size(), n = axes_[0].size();
+    for (const BurgAxis& a : axes_)
+      if (p == 0 || n == 0 || a.coefficients().size() != p || a.size() != n)
+        return {axes_[0].forecast(horizon), axes_[1].forecast(horizon), axes_[2].forecast(horizon)};
+    std::array<std::vector<double>, 3> s, out;
+    for (size_t i = 0; i < 3; ++i) {
+      s[i] = axes_[i].forecast_start(horizon);
+      out[i].reserve(static_cast<size_t>(horizon));
+    }
+    const double *a0 = axes_[0].coefficients().data(), *a1 = axes_[1].coefficients().data(),
+                 *a2 = axes_[2].coefficients().data();
+    for (int h = 0; h < horizon; ++h) {
+      const size_t size = s[0].size();
+      double n0 = 0, n1 = 0, n2 = 0;  // predict_next's sums
+      for (size_t k = 1; k <= p && k <= size; ++k) {
+        n0 -= a0[k - 1] * s[0][size - k];
+        n1 -= a1[k - 1] * s[1][size - k];
+        n2 -= a2[k - 1] * s[2][size - k];
+      }
+      s[0].push_back(n0), s[1].push_back(n1), s[2].push_back(n2);
+      out[0].push_back(n0 + axes_[0].mean());
+      out[1].push_back(n1 + axes_[1].mean());
+      out[2].push_back(n2 + axes_[2].mean());
+    }
+    return out;
   }
 
  private:
+  /// Each axis's window mean, as BurgAxis::add computes it (summed in order from 0), the three
+  /// sums in one pass.
+  void update_means() {
+    const size_t n = axes_[0].size();
+    bool together = axes_[1].size() == n && axes_[2].size() == n;
+    for (const BurgAxis& a : axes_) together = together && a.removes_mean();
+    if (!together || n == 0) {
+      for (BurgAxis& a : axes_) a.set_mean(a.window_mean());
+      return;
+    }
+    double s0 = 0, s1 = 0, s2 = 0;
+    auto i0 = axes_[0].history().begin(), i1 = axes_[1].history().begin(),
+         i2 = axes_[2].history().begin();
+    for (size_t i = 0; i < n; ++i, ++i0, ++i1, ++i2) s0 += *i0, s1 += *i1, s2 += *i2;
+    const double count = static_cast<double>(n);
+    axes_[0].set_mean(s0 / count), axes_[1].set_mean(s1 / count), axes_[2].set_mean(s2 / count);
+  }
+
   void estimate() {
     std::array<const std::vector<double>*, 3> c{};
     for (size_t i = 0; i < 3; ++i) c[i] = axes_[i].centred_window();

@@ -70,6 +70,41 @@ TEST(Burg, MatchesOctavesArburg) {
   }
 }
 
+// The three-axis Burg model (three windows summed and estimated in one pass, the three forecasts
+// in one loop) is three one-axis models, bit for bit: through measurements, an occlusion's
+// fed-back samples, the gap replaced by its line, and a window that has filled and slides.
+TEST(Burg, TrajectoryModelIsThreeAxisModelsBitForBit) {
+  BurgParams p;
+  p.order = 6;
+  p.window = 60;
+  const auto three = make_burg_trajectory({p, p, p});
+  std::array<std::unique_ptr<AxisModel>, 3> one{make_burg_axis(p), make_burg_axis(p),
+                                                make_burg_axis(p)};
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0, 0.002);
+  for (int k = 0; k < 150; ++k) {
+    const bool measured = k % 40 < 34;  // six samples hidden in every forty
+    const std::array<double, 3> v{0.4 + 0.2 * std::cos(0.07 * k) + noise(rng),
+                                  0.2 * std::sin(0.07 * k) + noise(rng), 0.1 + noise(rng)};
+    if (measured && k % 40 == 0 && k > 0) {  // back: the hidden samples become a line
+      std::array<std::vector<double>, 3> line;
+      for (size_t a = 0; a < 3; ++a) {
+        line[a] = {v[a] - 0.01, v[a] - 0.005};
+        one[a]->replace_newest(line[a]);
+      }
+      three->replace_newest(line);
+    }
+    three->push(v, measured);
+    for (size_t a = 0; a < 3; ++a) one[a]->push(v[a], measured);
+    const std::array<std::vector<double>, 3> f = three->forecast(16);
+    for (size_t a = 0; a < 3; ++a) {
+      SCOPED_TRACE(testing::Message() << "sample " << k << ", axis " << a);
+      ASSERT_EQ(f[a], one[a]->forecast(16));  // exact: bit for bit
+      ASSERT_EQ(f[a].size(), 16u);
+    }
+  }
+}
+
 // The prediction error power never increases with the order (the guard against the paper's sign
 // burg3 on three signals (a circle's x and y, noise) is burg on each, bit for bit: reflection
 // coefficients, coefficients and error powers, for short and long windows and several orders.
