@@ -73,12 +73,17 @@ class BurgAxis : public AxisModel {
       history_[history_.size() - n + i] = values[values.size() - n + i];
   }
 
-  /// The centred window to estimate from, or nullptr while the window is too short (the offline
-  /// coefficients, or none, stand until then).
-  const std::vector<double>* centred_window() {
+  /// Whether the window is long enough to estimate from (until then the offline coefficients,
+  /// or none, stand).
+  bool estimable() const {
     const int needed =
         p_.initial_coefficients.empty() ? p_.order + 3 : std::max(p_.order + 3, p_.online_after);
-    if (static_cast<int>(history_.size()) < needed) return nullptr;
+    return static_cast<int>(history_.size()) >= needed;
+  }
+
+  /// The centred window to estimate from, or nullptr while it is not estimable().
+  const std::vector<double>* centred_window() {
+    if (!estimable()) return nullptr;
     const double m = mean_;
     centred_.assign(history_.begin(), history_.end());
     for (double& v : centred_) v -= m;
@@ -182,20 +187,19 @@ class BurgTrajectory : public TrajectoryModel {
   }
 
   void estimate() {
-    std::array<const std::vector<double>*, 3> c{};
-    for (size_t i = 0; i < 3; ++i) c[i] = axes_[i].centred_window();
-    const bool together = c[0] && c[1] && c[2] && c[0]->size() == c[1]->size() &&
-                          c[1]->size() == c[2]->size() && axes_[0].order() == axes_[1].order() &&
-                          axes_[1].order() == axes_[2].order();
+    bool together = axes_[0].size() == axes_[1].size() && axes_[1].size() == axes_[2].size() &&
+                    axes_[0].order() == axes_[1].order() && axes_[1].order() == axes_[2].order();
+    for (const BurgAxis& a : axes_) together = together && a.estimable();
     if (!together) {
-      for (size_t i = 0; i < 3; ++i)
-        if (c[i])
-          axes_[i].set_coefficients(
-              burg(c[i]->data(), static_cast<int>(c[i]->size()), axes_[i].order()).coefficients);
+      for (BurgAxis& a : axes_)
+        if (const auto* c = a.centred_window())
+          a.set_coefficients(burg(c->data(), static_cast<int>(c->size()), a.order()).coefficients);
       return;
     }
-    std::array<BurgResult, 3> r = burg3({c[0]->data(), c[1]->data(), c[2]->data()},
-                                        static_cast<int>(c[0]->size()), axes_[0].order());
+    // Centred as each axis centres its copy, read from the windows themselves.
+    std::array<BurgResult, 3> r =
+        burg3_centred({&axes_[0].history(), &axes_[1].history(), &axes_[2].history()},
+                      {axes_[0].mean(), axes_[1].mean(), axes_[2].mean()}, axes_[0].order());
     for (size_t i = 0; i < 3; ++i) axes_[i].set_coefficients(std::move(r[i].coefficients));
   }
 

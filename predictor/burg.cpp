@@ -123,17 +123,44 @@ template <class V>
 
 /// The three axes' recursion, compiled for AVX2 (one instruction for the three) and for the
 /// baseline; the loader picks the clone the CPU runs. The stages are inlined into each clone.
-/// f and b: n Lanes each, aligned to 32 bytes, filled here with the three signals.
-__attribute__((target_clones("avx2", "default"))) void burg_three(
-    const std::array<const double*, 3>& x, Lanes* f, Lanes* b, int n, int order, BurgResult* out) {
+/// f and b: n Lanes each, aligned to 32 bytes, filled here with the three signals: sample i is
+/// `x(i, v)` sets v to sample i, the three values at once (a Lanes is not returned: without AVX
+/// the ABI would differ).
+template <class Signals>
+[[gnu::always_inline]] inline void burg_three(const Signals& x, Lanes* f, Lanes* b, int n,
+                                              int order, BurgResult* out) {
   Lanes energy{};  // each lane summed in index order, as burg() sums its one signal
   for (int i = 0; i < n; ++i) {
-    const Lanes v{x[0][i], x[1][i], x[2][i], 0};
+    Lanes v;
+    x(i, v);
     f[i] = b[i] = v;  // eq. 33, 34: e_0^f = e_0^b = x
     energy += v * v;
   }
   const double e[3] = {energy[0], energy[1], energy[2]};
   burg_stages(f, b, n, order, e, 3, out);
+}
+
+__attribute__((target_clones("avx2", "default"))) void burg_three_arrays(
+    const std::array<const double*, 3>& x, Lanes* f, Lanes* b, int n, int order, BurgResult* out) {
+  burg_three(
+      [&](int i, Lanes& v) {
+        v = Lanes{x[0][i], x[1][i], x[2][i], 0};
+      },
+      f, b, n, order, out);
+}
+
+/// The same from three windows, each sample centred as it is read: w - m, as an axis model centres
+/// its copy.
+__attribute__((target_clones("avx2", "default"))) void burg_three_centred(
+    const std::array<const std::deque<double>*, 3>& w, const std::array<double, 3>& m, Lanes* f,
+    Lanes* b, int n, int order, BurgResult* out) {
+  auto i0 = w[0]->begin(), i1 = w[1]->begin(), i2 = w[2]->begin();
+  burg_three(
+      [&](int, Lanes& v) {
+        v = Lanes{*i0 - m[0], *i1 - m[1], *i2 - m[2], 0};
+        ++i0, ++i1, ++i2;
+      },
+      f, b, n, order, out);
 }
 
 void check(int n, int order) {
@@ -156,17 +183,37 @@ BurgResult burg(const double* x, int n, int order) {
   return out;
 }
 
-std::array<BurgResult, 3> burg3(const std::array<const double*, 3>& x, int n, int order) {
-  check(n, order);
-  // Four doubles a sample in memory aligned to 32 bytes (a std::vector of a vector type would
-  // lose the type's alignment: GCC drops attributes on template arguments).
+namespace {
+
+/// burg3's f and b, n Lanes each: four doubles a sample in memory aligned to 32 bytes (a
+/// std::vector of a vector type would lose the type's alignment: GCC drops attributes on template
+/// arguments), kept from call to call.
+Lanes* three_buffers(int n) {
   thread_local std::vector<double> memory;
   memory.resize(8 * static_cast<size_t>(n) + 4);
   const auto at = reinterpret_cast<uintptr_t>(memory.data());
-  Lanes* const f = reinterpret_cast<Lanes*>((at + 31) / 32 * 32);
-  Lanes* const b = f + n;
+  return reinterpret_cast<Lanes*>((at + 31) / 32 * 32);
+}
+
+}  // namespace
+
+std::array<BurgResult, 3> burg3(const std::array<const double*, 3>& x, int n, int order) {
+  check(n, order);
+  Lanes* const f = three_buffers(n);
   std::array<BurgResult, 3> out;
-  burg_three(x, f, b, n, order, out.data());
+  burg_three_arrays(x, f, f + n, n, order, out.data());
+  return out;
+}
+
+std::array<BurgResult, 3> burg3_centred(const std::array<const std::deque<double>*, 3>& windows,
+                                        const std::array<double, 3>& means, int order) {
+  const size_t n = windows[0]->size();
+  if (windows[1]->size() != n || windows[2]->size() != n)
+    throw std::invalid_argument("burg3_centred: the three windows differ in length");
+  check(static_cast<int>(n), order);
+  Lanes* const f = three_buffers(static_cast<int>(n));
+  std::array<BurgResult, 3> out;
+  burg_three_centred(windows, means, f, f + n, static_cast<int>(n), order, out.data());
   return out;
 }
 

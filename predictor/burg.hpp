@@ -1,6 +1,7 @@
 #pragma once
 
 #include <array>
+#include <deque>
 #include <vector>
 
 namespace sg::predictor {
@@ -28,6 +29,12 @@ BurgResult burg(const double* x, int n, int order);
 /// at once, in the lanes of one AVX2 register, so each result is bit for bit burg()'s (a test)
 /// for about the time of one (issue 19). Needs n > order.
 std::array<BurgResult, 3> burg3(const std::array<const double*, 3>& x, int n, int order);
+
+/// burg3 of three windows with their means taken off (x - mean, as the axis models centre them),
+/// read from the windows themselves rather than from centred copies. Needs all three windows of
+/// one size n > order.
+std::array<BurgResult, 3> burg3_centred(const std::array<const std::deque<double>*, 3>& windows,
+                                        const std::array<double, 3>& means, int order);
 
 /// One-step prediction of eq. 27 from the last p values of `history` (oldest first):
 /// -sum_k a_k history[size - k].

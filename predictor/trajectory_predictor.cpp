@@ -100,6 +100,8 @@ Forecast TrajectoryPredictor::emit_sample(int64_t grid, const Eigen::Vector3d& v
   // The samples the published sigma counts past a measurement (PredictorParams::after_gap).
   const int unseen = occluded_ > 0 ? occluded_ : since_gap_ < params_.after_gap ? last_gap_ : 0;
   if (measured && since_gap_ < params_.after_gap) ++since_gap_;
+  f.positions.reserve(static_cast<size_t>(params_.horizon));
+  f.sigma.reserve(static_cast<size_t>(params_.horizon));
   for (int h = 0; h < params_.horizon; ++h) {
     f.positions.emplace_back(axis[0][static_cast<size_t>(h)], axis[1][static_cast<size_t>(h)],
                              axis[2][static_cast<size_t>(h)]);

@@ -37,8 +37,8 @@ struct Pipeline {
 };
 
 // 300 frames (10 s) of the simulated lab: every blob and OBJECT_POSITION of the region pipeline
-// equals the full pipeline's; in tracking mode each camera decoded only its window's iMCUs, under
-// a quarter of its frame.
+// equals the full pipeline's; in tracking mode each camera decoded only its window, 4 px around
+// it and the iMCUs they touch, under a quarter of its frame.
 TEST(FrameDecoder, RegionDecodingTracksAsFullDecodingDoes) {
   sim::SimParams params;
   sim::CameraSimulator sim(params);
@@ -58,9 +58,9 @@ TEST(FrameDecoder, RegionDecodingTracksAsFullDecodingDoes) {
       EXPECT_EQ(sg::encode_message(a.blob[i]), sg::encode_message(b.blob[i]));  // every field
       if (b.observation[i].tracking) {
         ++tracking;
-        // the window, one iMCU (16 px) around it, and the crop's alignment to an iMCU column
+        // the window, 4 px around it, and the alignment of its top left to an iMCU (16 px)
         const cv::Rect w = b.observation[i].window, d = region.decoders[i].decoded();
-        const cv::Rect reach(w.x - 32, w.y - 16, w.width + 48, w.height + 32);
+        const cv::Rect reach(w.x - 4 - 15, w.y - 4 - 15, w.width + 8 + 15, w.height + 8 + 15);
         small += (d & reach) == d && d.area() * 4 < m[i].width * m[i].height;
       }
     }
