@@ -123,9 +123,8 @@ template <class V>
 
 /// The three axes' recursion, compiled for AVX2 (one instruction for the three) and for the
 /// baseline; the loader picks the clone the CPU runs. The stages are inlined into each clone.
-/// f and b: n Lanes each, aligned to 32 bytes, filled here with the three signals: sample i is
-/// `x(i, v)` sets v to sample i, the three values at once (a Lanes is not returned: without AVX
-/// the ABI would differ).
+/// f and b: n Lanes each, aligned to 32 bytes, filled here with the three signals: `x(i, v)` sets
+/// v to sample i of the three (a Lanes is not returned: without AVX the ABI would differ).
 template <class Signals>
 [[gnu::always_inline]] inline void burg_three(const Signals& x, Lanes* f, Lanes* b, int n,
                                               int order, BurgResult* out) {
@@ -140,6 +139,7 @@ template <class Signals>
   burg_stages(f, b, n, order, e, 3, out);
 }
 
+/// burg_three from three arrays.
 __attribute__((target_clones("avx2", "default"))) void burg_three_arrays(
     const std::array<const double*, 3>& x, Lanes* f, Lanes* b, int n, int order, BurgResult* out) {
   burg_three(

@@ -106,7 +106,6 @@ TEST(Burg, TrajectoryModelIsThreeAxisModelsBitForBit) {
   }
 }
 
-// The prediction error power never increases with the order (the guard against the paper's sign
 // burg3 on three signals (a circle's x and y, noise) is burg on each, bit for bit: reflection
 // coefficients, coefficients and error powers, for short and long windows and several orders.
 TEST(Burg, ThreeAxesInOnePassAreEachAxisBitForBit) {
@@ -158,6 +157,7 @@ TEST(Burg, ThreeCentredWindowsAreEachCentredAxisBitForBit) {
   }
 }
 
+// The prediction error power never increases with the order (the guard against the paper's sign
 // error in eq. 30-32, which breaks every order above 1).
 TEST(Burg, ErrorPowerNeverIncreasesWithOrder) {
   for (const Reference& r : load_reference()) {
