@@ -39,6 +39,9 @@ ForecastError::ForecastError(int horizon, int max_gap, const ForecastErrorParams
     const double s = p.prior_sigma * static_cast<double>(b + 1);
     window_[b * w] = sum_[b] = Eigen::Vector3d::Constant(s * s);
   }
+  estimate_.resize(n);
+  widen_.resize(n);
+  for (size_t b = 0; b < n; ++b) refresh(b);
   kept_.resize(static_cast<size_t>(horizon));
   for (Kept& k : kept_) k.positions.reserve(static_cast<size_t>(horizon));
 }
@@ -81,6 +84,13 @@ void ForecastError::add(size_t b, const Eigen::Vector3d& value, const Eigen::Vec
       noise_sum_[b] += noise_ring[i];
     }
   }
+  refresh(b);
+}
+
+void ForecastError::refresh(size_t b) {
+  const Eigen::Vector3d square = (sum_[b] - noise_sum_[b]) / static_cast<double>(filled_[b]);
+  estimate_[b] = square.cwiseMax(0).cwiseSqrt().cwiseMax(params_.min_sigma);
+  widen_[b] = params_.predictive ? predictive_factor(filled_[b]) : 1.0;
 }
 
 void ForecastError::record(int64_t utime, int occluded, const std::vector<Eigen::Vector3d>& pos,
@@ -112,7 +122,7 @@ void ForecastError::score(int64_t utime, const Eigen::Vector3d& sample,
     const Eigen::Vector3d e = sample - k.positions[static_cast<size_t>(h - 1)];
     if (!(e.cwiseAbs().maxCoeff() <= 1e6)) continue;  // NaN too
     const size_t b = bucket(h + k.occluded);
-    const Eigen::Vector3d expected = estimate(b).cwiseAbs2() + noise;
+    const Eigen::Vector3d expected = estimate_[b].cwiseAbs2() + noise;
     add_surprise(b, {(e.cwiseAbs2().array() / expected.array()).mean(), e.cwiseAbs2() - expected});
     add(b, e.cwiseAbs2(), noise);
     ++scores_[b];
@@ -162,15 +172,9 @@ void ForecastError::reset() {
   std::fill(fresh_.begin(), fresh_.end(), 0);
 }
 
-Eigen::Vector3d ForecastError::estimate(size_t b) const {
-  const Eigen::Vector3d square = (sum_[b] - noise_sum_[b]) / static_cast<double>(filled_[b]);
-  return square.cwiseMax(0).cwiseSqrt().cwiseMax(params_.min_sigma);
-}
-
 Eigen::Vector3d ForecastError::sigma(int samples) const {
   const size_t b = bucket(samples);
-  const double widen = params_.predictive ? predictive_factor(filled_[b]) : 1.0;
-  Eigen::Vector3d s = widen * estimate(b);
+  Eigen::Vector3d s = widen_[b] * estimate_[b];
   if (fresh_[b] < params_.fresh_scores)  // a new model: no surer than the prior until scored
     s = s.cwiseMax(params_.prior_sigma * static_cast<double>(b + 1));
   return (s.cwiseAbs2() + turn_[b].cwiseAbs2()).cwiseSqrt();

@@ -137,8 +137,9 @@ class ForecastError {
     double z2 = 0;
     Eigen::Vector3d excess = Eigen::Vector3d::Zero();
   };
-  /// sigma(b) without the predictive factor or the turn: s_b.
-  Eigen::Vector3d estimate(size_t b) const;
+  /// Bucket b's s_b (sigma without the predictive factor or the turn) and its predictive factor,
+  /// afresh from its window: kept, as they change only when an entry is added.
+  void refresh(size_t b);
   /// Adds a score's surprise to bucket b's ring.
   void add_surprise(size_t b, Surprise s);
   /// T_b afresh for every bucket (after a sample's scores).
@@ -157,6 +158,8 @@ class ForecastError {
   std::vector<Surprise> surprise_sum_;   // per bucket: the sum of its ring
   std::vector<int> surprise_filled_;     // per bucket: entries in its ring
   std::vector<Eigen::Vector3d> turn_;    // per bucket: T_b
+  std::vector<Eigen::Vector3d> estimate_;  // per bucket: s_b (refresh())
+  std::vector<double> widen_;              // per bucket: predictive_factor(filled_) or 1
   std::vector<int> fresh_;               // per bucket: scores since reset(), up to fresh_scores
   std::vector<Kept> kept_;               // a ring of the last `horizon` forecasts
   size_t next_ = 0;                      // where the next forecast goes

@@ -49,6 +49,7 @@ void TrajectoryPredictor::reset() {
       a = params_.model == Model::kKalman ? make_kalman_axis(params_.kalman) : make_hold_axis();
     model_ = make_axes_trajectory(std::move(axes));
   }
+  newest_one_step_.reset();
   started_ = false;
   have_seen_ = false;
   occluded_ = 0;
@@ -58,6 +59,7 @@ void TrajectoryPredictor::reset() {
 }
 
 Eigen::Vector3d TrajectoryPredictor::one_step() const {
+  if (newest_one_step_) return *newest_one_step_;
   const std::array<std::vector<double>, 3> next = model_->forecast(1);
   return {next[0].front(), next[1].front(), next[2].front()};
 }
@@ -97,6 +99,11 @@ Forecast TrajectoryPredictor::emit_sample(int64_t grid, const Eigen::Vector3d& v
   f.sample = value;
   last_sample_ = value;
   const std::array<std::vector<double>, 3> axis = model_->forecast(params_.horizon);
+  // The model stays as it is until the next grid sample: its one-step forecast is this one's first
+  // point (forecast(1) computes it in the same order), for the gate and a fed-back sample.
+  newest_one_step_.reset();
+  if (!axis[0].empty() && !axis[1].empty() && !axis[2].empty())
+    newest_one_step_ = Eigen::Vector3d(axis[0].front(), axis[1].front(), axis[2].front());
   // The samples the published sigma counts past a measurement (PredictorParams::after_gap).
   const int unseen = occluded_ > 0 ? occluded_ : since_gap_ < params_.after_gap ? last_gap_ : 0;
   if (measured && since_gap_ < params_.after_gap) ++since_gap_;

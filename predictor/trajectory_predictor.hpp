@@ -125,6 +125,7 @@ class TrajectoryPredictor {
   std::string insane(const Forecast& f) const;
   Forecast emit_sample(int64_t grid_utime, const Eigen::Vector3d& value, bool measured,
                        int64_t source);
+  /// The model's forecast one grid sample ahead of the newest: the newest forecast's first point.
   Eigen::Vector3d one_step() const;
   /// True when a visible measurement disagrees with the forecast beyond the gate (and patience).
   bool outside_gate(const Measurement& m);
@@ -152,6 +153,7 @@ class TrajectoryPredictor {
   std::string last_reset_;
   int backward_run_ = 0;                 // measurements in a row refused as not after the last
   std::optional<int64_t> gating_since_;  // first of the current run of gated measurements
+  std::optional<Eigen::Vector3d> newest_one_step_;  // the newest forecast's first point
 };
 
 }  // namespace sg::predictor
