@@ -182,6 +182,7 @@ void Bus::subscribe_raw(const std::string& channel_regex,
     lcm_->unsubscribe(subscription);
     throw BusError(refused);
   }
+  ++lcm_subscriptions_;
 }
 
 /// The channels read on the bus's own socket (subscribe_direct).
@@ -255,8 +256,11 @@ bool Bus::drain_direct() {
 bool Bus::handle(std::chrono::milliseconds timeout) {
   tick();
   if (!direct_) return handle_lcm(static_cast<int>(timeout.count()));
-  pollfd fds[2] = {{direct_->socket.fd(), POLLIN, 0}, {lcm_->getFileno(), POLLIN, 0}};
-  const int ready = poll(fds, 2, static_cast<int>(timeout.count()));
+  // LCM's descriptor only when it has subscriptions: asking for it starts LCM's receive thread.
+  const bool lcm_too = lcm_subscriptions_ > 0;
+  pollfd fds[2] = {{direct_->socket.fd(), POLLIN, 0},
+                   {lcm_too ? lcm_->getFileno() : -1, POLLIN, 0}};
+  const int ready = poll(fds, lcm_too ? 2 : 1, static_cast<int>(timeout.count()));
   if (ready < 0) {
     if (errno == EINTR) return false;
     throw BusError(std::string("waiting for messages failed: ") + std::strerror(errno));
@@ -319,10 +323,14 @@ void Bus::announce(const std::string& process, int8_t state, const std::string& 
     start_utime_ = now_utime();
     clock_sync_ = std::make_unique<ClockSync>(process_ + "@" + host_ + ":" +
                                               std::to_string(static_cast<int32_t>(getpid())));
-    subscribe<stereograsp::process_status_t>(
-        "PROCESS_STATUS", [this](const stereograsp::process_status_t& s, const ReceiveInfo& info) {
+    std::function<void(const stereograsp::process_status_t&, const ReceiveInfo&)> echo =
+        [this](const stereograsp::process_status_t& s, const ReceiveInfo& info) {
           clock_sync_->receive(s, info.recv_utime);
-        });
+        };
+    if (direct_)
+      subscribe_direct<stereograsp::process_status_t>("PROCESS_STATUS", std::move(echo));
+    else
+      subscribe<stereograsp::process_status_t>("PROCESS_STATUS", std::move(echo));
   }
   next_status_ = {};
   tick();

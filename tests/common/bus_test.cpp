@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <thread>
 
 #include "common/clock.hpp"
@@ -188,6 +189,40 @@ TEST(Bus, DirectChannelsCountWhatTheyRefuse) {
   ASSERT_TRUE(test::eventually([&] { return (bus.handle(20ms), calls == 2); }, 10s, "two images"));
   EXPECT_EQ(bus.decode_errors(), 2u) << bus.last_problem();
   EXPECT_EQ(bus.handler_errors(), 1u);
+}
+
+/// Threads in this process (entries of /proc/self/task).
+size_t threads() {
+  return static_cast<size_t>(std::distance(std::filesystem::directory_iterator("/proc/self/task"),
+                                           std::filesystem::directory_iterator{}));
+}
+
+// A bus that reads its channels directly reads PROCESS_STATUS directly too: announcing and
+// handling start no LCM receive thread (a second reader of every camera frame), and the clock
+// exchange with another process's bus still completes.
+TEST(Bus, DirectBusStartsNoLcmReceiveThreadAndStillSyncsClocks) {
+  ASSERT_TRUE(test::multicast_available(7978));
+  Bus bus(test::test_url(7978));
+  const size_t before = threads();
+  int images = 0;
+  ASSERT_TRUE(bus.subscribe_direct<stereograsp::image_t>(
+      "CAMERA_LEFT", [&](const stereograsp::image_t&, const ReceiveInfo&) { ++images; }));
+  bus.announce("direct-reader");
+  for (int i = 0; i < 5; ++i) bus.handle(10ms);
+  EXPECT_EQ(threads(), before);
+  Bus other(test::test_url(7978));  // an ordinary bus: LCM's receive thread reads for it
+  other.announce("lcm-reader");
+  other.publish("CAMERA_LEFT", make_image(1, 1000));
+  ASSERT_TRUE(test::eventually(
+      [&] {
+        bus.handle(10ms), other.handle(10ms);
+        return images == 1 &&
+               bus.clock_sync()->offset("lcm-reader@" + heard_host() + ":" +
+                                        std::to_string(getpid())) &&
+               other.clock_sync()->offset("direct-reader@" + heard_host() + ":" +
+                                          std::to_string(getpid()));
+      },
+      10s, "the image, and each bus's offset to the other"));
 }
 
 // On a bus that is not udpm:// a direct subscription is LCM's own, and still delivers.
