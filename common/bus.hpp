@@ -151,8 +151,7 @@ class Bus {
   /// announces once it serves; STATE_STARTING while it waits for something, set_state() when
   /// that comes). From then on the bus also listens to PROCESS_STATUS and echoes the other
   /// processes' statuses in its own, so each measures its clock's offset to the others
-  /// (sg::ClockSync, docs/lab.md); a bus that reads channels directly (subscribe_direct) reads
-  /// PROCESS_STATUS directly too. The last status, from spin() when a shutdown was requested or
+  /// (sg::ClockSync, docs/lab.md). The last status, from spin() when a shutdown was requested or
   /// else from the destructor, is STATE_STOPPING: a watcher tells a process that stopped from one
   /// that died.
   void announce(const std::string& process,
