@@ -7,7 +7,7 @@
 //   - sg::Bus::subscribe_direct, as sg-vision reads its camera channels: the bus's own socket on
 //     the group, read in the thread that spins, an empty handler.
 //   - the first again with a second socket on the group read by another thread (what LCM's
-//     receive thread was in sg-vision until it read PROCESS_STATUS directly too): on a 2-vCPU
+//     receive thread is beside a bus's own socket, in sg-vision for PROCESS_STATUS): on a 2-vCPU
 //     machine whose idle vCPU is slow to wake, p99 66-91 us alone, about 3 ms with it.
 // sg-vision's "of which LCM's delivery" is the second with a real handler around it; a p99 here
 // above sg-vision's goal (1.5 ms) is the platform's, not the program's.
