@@ -10,8 +10,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 
 #include "common/clock.hpp"
+#include "common/lcm_channel_filter.hpp"
 #include "common/lcm_datagram.hpp"
 #include "common/log_format.hpp"
 #include "common/shutdown.hpp"
@@ -175,6 +177,8 @@ void Bus::subscribe_raw(const std::string& channel_regex,
       "cannot hold " + std::to_string(queue) + " messages for '" + channel_regex + "'";
   if (queue < 1) throw BusError(refused);  // before subscribing: nothing is left half-made
   handlers_.push_back(std::make_unique<RawHandler>(*this, std::move(handler)));
+  // LCM opens its receive socket at the first subscription; it is the one that appears.
+  const std::vector<int> before = lcm_subscriptions_ == 0 ? lcm_sockets() : std::vector<int>{};
   lcm::Subscription* subscription =
       lcm_->subscribe(channel_regex, &RawHandler::handleMessage, handlers_.back().get());
   if (subscription == nullptr) throw BusError("cannot subscribe to '" + channel_regex + "'");
@@ -182,7 +186,46 @@ void Bus::subscribe_raw(const std::string& channel_regex,
     lcm_->unsubscribe(subscription);
     throw BusError(refused);
   }
-  ++lcm_subscriptions_;
+  if (lcm_subscriptions_++ == 0) find_lcm_socket(before);
+  if (is_plain_channel_name(channel_regex))
+    lcm_channels_.push_back(channel_regex);
+  else
+    lcm_channels_any_ = true;
+  filter_lcm_socket();
+}
+
+std::vector<int> Bus::lcm_sockets() const {
+  std::optional<UdpmEndpoint> endpoint;
+  try {
+    endpoint = udpm_endpoint(url_);
+  } catch (const std::invalid_argument&) {
+    return {};  // LCM refused it in the constructor
+  }
+  return endpoint ? udp_sockets_bound_to(endpoint->port) : std::vector<int>{};
+}
+
+void Bus::find_lcm_socket(const std::vector<int>& before) {
+  std::vector<int> appeared;
+  for (const int fd : lcm_sockets())
+    if (std::find(before.begin(), before.end(), fd) == before.end()) appeared.push_back(fd);
+  if (appeared.size() == 1) lcm_socket_ = appeared.front();
+}
+
+void Bus::filter_lcm_socket() {
+  if (lcm_socket_ < 0) return;
+  if (lcm_channels_any_) {
+    detach_lcm_channel_filter(lcm_socket_);
+    lcm_filtered_ = false;
+    return;
+  }
+  try {
+    attach_lcm_channel_filter(lcm_socket_, lcm_channels_);
+    lcm_filtered_ = true;
+  } catch (const std::exception& e) {  // the filter only saves wake-ups; LCM reads on without
+    spdlog::warn("bus {}: {}", url_, e.what());
+    detach_lcm_channel_filter(lcm_socket_);
+    lcm_filtered_ = false;
+  }
 }
 
 /// The channels read on the bus's own socket (subscribe_direct).
@@ -221,6 +264,13 @@ bool Bus::subscribe_direct_raw(const std::string& channel,
   if (direct_->handler_of(channel) != nullptr)
     throw BusError("channel '" + channel + "' is already read directly");
   direct_->channels.emplace_back(channel, std::make_unique<RawHandler>(*this, std::move(handler)));
+  std::vector<std::string> names;
+  for (const auto& [name, unused] : direct_->channels) names.push_back(name);
+  try {
+    attach_lcm_channel_filter(direct_->socket.fd(), names);
+  } catch (const std::exception& e) {  // it reads every datagram then, and drops the others
+    spdlog::warn("bus {}: {}", url_, e.what());
+  }
   return true;
 }
 

@@ -184,7 +184,14 @@ class Bus {
   /// Clock offsets to the other announced processes (empty before announce()).
   const ClockSync* clock_sync() const { return clock_sync_.get(); }
 
-  /// The underlying LCM object, for what this wrapper does not cover.
+  /// True when LCM's receive socket carries a kernel filter (sg::attach_lcm_channel_filter) that
+  /// lets through only the channels subscribed through this bus: on a `udpm://` bus whose
+  /// subscriptions all name one channel each (no pattern such as "BLOB_.*", which lifts it).
+  /// The datagrams of other channels, which LCM would read and drop, then wake no thread here.
+  bool lcm_filtered() const { return lcm_filtered_; }
+
+  /// The underlying LCM object, for what this wrapper does not cover. Subscribe through the bus,
+  /// not here: LCM's socket delivers only the channels the bus subscribed (lcm_filtered()).
   lcm::LCM& lcm() { return *lcm_; }
 
  private:
@@ -222,6 +229,18 @@ class Bus {
   /// a second time (a second reader woken by each camera frame: p99 3 ms on a 2-vCPU machine,
   /// docs/performance.md).
   int lcm_subscriptions_ = 0;
+  /// LCM's receive socket (-1: not found, or not udpm) and the channels its filter lets through;
+  /// a pattern among the subscriptions lets everything through.
+  int lcm_socket_ = -1;
+  std::vector<std::string> lcm_channels_;
+  bool lcm_channels_any_ = false;
+  bool lcm_filtered_ = false;
+  /// This process's UDP sockets on the bus's port (none: not udpm).
+  std::vector<int> lcm_sockets() const;
+  /// Takes the one socket that is new since `before` as LCM's.
+  void find_lcm_socket(const std::vector<int>& before);
+  /// Attaches (or lifts) the filter for the subscriptions so far.
+  void filter_lcm_socket();
   std::vector<uint8_t> buffer_;
   uint64_t messages_received_ = 0;
   uint64_t decode_errors_ = 0;

@@ -212,6 +212,36 @@ TEST(Bus, DirectBusWithoutLcmSubscriptionsStartsNoLcmReceiveThread) {
   EXPECT_EQ(threads(), before);
 }
 
+// LCM's receive socket is filtered to the channels subscribed by name (each bus its own, two in
+// one process), which still arrive; a pattern among the subscriptions lifts the filter, and
+// what it matches arrives too.
+TEST(Bus, LcmSocketFilteredToNamedChannelsUntilAPattern) {
+  ASSERT_TRUE(test::multicast_available(7979));
+  Bus a(test::test_url(7979)), b(test::test_url(7979)), sender(test::test_url(7979));
+  EXPECT_FALSE(a.lcm_filtered());  // no subscription yet
+  int points = 0, statuses = 0, blobs = 0;
+  a.subscribe<point3_t>("OBJECT_POSITION", [&](const point3_t&, const ReceiveInfo&) { ++points; });
+  b.subscribe<stereograsp::process_status_t>(
+      "PROCESS_STATUS",
+      [&](const stereograsp::process_status_t&, const ReceiveInfo&) { ++statuses; });
+  EXPECT_TRUE(a.lcm_filtered());
+  EXPECT_TRUE(b.lcm_filtered());
+  sender.publish("CAMERA_LEFT", make_image(1, 1000));
+  sender.publish("OBJECT_POSITION", make_point(2, 0.5));
+  sender.publish("PROCESS_STATUS", stereograsp::process_status_t{});
+  ASSERT_TRUE(test::eventually(
+      [&] { return (a.handle(10ms), b.handle(10ms), points == 1 && statuses == 1); }, 10s,
+      "each bus's channel"));
+  a.subscribe<blob_t>("BLOB_(LEFT|RIGHT)", [&](const blob_t&, const ReceiveInfo&) { ++blobs; });
+  EXPECT_FALSE(a.lcm_filtered());
+  EXPECT_TRUE(b.lcm_filtered());
+  sender.publish("BLOB_RIGHT", blob_t{});
+  sender.publish("OBJECT_POSITION", make_point(3, 0.5));
+  ASSERT_TRUE(test::eventually([&] { return (a.handle(10ms), blobs == 1 && points == 2); }, 10s,
+                               "the pattern's channel and the named one"));
+  EXPECT_EQ(a.decode_errors() + b.decode_errors(), 0u);
+}
+
 // On a bus that is not udpm:// a direct subscription is LCM's own, and still delivers.
 TEST(Bus, DirectSubscriptionFallsBackToLcmOffUdpm) {
   Bus bus("memq://");
