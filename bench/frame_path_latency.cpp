@@ -3,11 +3,14 @@
 // host) to sg-vision and sg-predictor, started as processes; this program times OBJECT_POSITION
 // and OBJECT_TRAJECTORY as they arrive (their receive time less the frames' utime) and reads
 // sg-vision's own figure, second image received -> OBJECT_POSITION published, from its summary.
-// Four runs: JPEG with only the search windows decoded (vision.decode: region, the default) and
-// the camera channels read on sg-vision's own socket (vision.camera_read: direct, the default);
-// the same read through LCM's subscription (the baseline for the direct read); JPEG decoded
-// whole (the baseline for the windows); raw BGR8. The frames are the simulated lab's, rendered and
-// encoded before the run (sg-camera-sim's encoder), so rendering is not timed.
+// Five runs: JPEG with only the search windows decoded (vision.decode: region, the default), the
+// camera channels read on sg-vision's own socket (vision.camera_read: direct, the default) and
+// sg-vision awake when a pair is due (vision.busy_wait_ms, the default); the same read through
+// LCM's subscription (the baseline for the direct read); the same asleep until frames come
+// (busy_wait_ms: 0, the baseline for staying awake); JPEG decoded whole (the baseline for the
+// windows); raw BGR8. The frames are the simulated lab's, rendered and encoded before the run
+// (sg-camera-sim's encoder), so rendering is not timed; they are paced as sg-camera-sim paces
+// them.
 //
 //   scripts/multicast.sh run build/bin/frame_path_latency [--pairs 300] [--rate 20]
 //
@@ -130,8 +133,13 @@ struct RunSettings {
 };
 
 /// One run: the two programs, `pairs` frames at `rate` Hz, what arrived.
+/// How sg-vision runs: vision.decode, vision.camera_read, vision.busy_wait_ms ("": the default).
+struct VisionVariant {
+  std::string decode = "region", camera_read = "direct", busy_wait_ms;
+};
+
 void run(const RunSettings& rs, const std::vector<std::array<image_t, 2>>& frames,
-         const std::string& decode, const std::string& camera_read, Run& out) {
+         const VisionVariant& variant, Run& out) {
   const std::string &url = rs.url, &dir = rs.dir;
   const int pairs = rs.pairs;
   const double rate = rs.rate;
@@ -147,11 +155,21 @@ void run(const RunSettings& rs, const std::vector<std::array<image_t, 2>>& frame
                                            [&](const auto& m, const auto& info) {
                                              out.trajectory.add(info.recv_utime - m.source_utime);
                                            });
-  Program vision("sg-vision",
-                 {"--calibration", dir + "/cams.yaml", "--decode", decode, "--camera-read",
-                  camera_read, "--lcm-url", url, "--log-level", "warn", "--realtime-priority",
-                  std::to_string(rs.realtime_priority)},
-                 dir + "/vision.out");
+  std::vector<std::string> vision_args = {"--calibration",
+                                          dir + "/cams.yaml",
+                                          "--decode",
+                                          variant.decode,
+                                          "--camera-read",
+                                          variant.camera_read,
+                                          "--lcm-url",
+                                          url,
+                                          "--log-level",
+                                          "warn",
+                                          "--realtime-priority",
+                                          std::to_string(rs.realtime_priority)};
+  if (!variant.busy_wait_ms.empty())
+    vision_args.insert(vision_args.end(), {"--busy-wait-ms", variant.busy_wait_ms});
+  Program vision("sg-vision", vision_args, dir + "/vision.out");
   Program predictor("sg-predictor",
                     {"--config", dir + "/predictor.yaml", "--lcm-url", url, "--log-level", "warn"},
                     dir + "/predictor.out");
@@ -167,11 +185,12 @@ void run(const RunSettings& rs, const std::vector<std::array<image_t, 2>>& frame
       pair[i].utime = now, pair[i].frame_number = k;
       bus.publish(i == 0 ? "CAMERA_LEFT" : "CAMERA_RIGHT", pair[i]);
     }
+    // Paced as sg-camera-sim paces its frames (a camera's clock): asleep until the next, then
+    // what LCM's thread received meanwhile (its receive times are stamped as it arrived).
     next += std::chrono::duration_cast<std::chrono::steady_clock::duration>(period);
-    while (std::chrono::steady_clock::now() < next)
-      bus.handle(std::chrono::duration_cast<std::chrono::milliseconds>(
-                     next - std::chrono::steady_clock::now()) +
-                 1ms);
+    std::this_thread::sleep_until(next);
+    while (bus.handle(0ms)) {
+    }
   }
   const auto end = std::chrono::steady_clock::now() + 1s;  // the last ones in flight
   while (std::chrono::steady_clock::now() < end) bus.handle(50ms);
@@ -186,6 +205,8 @@ void run(const RunSettings& rs, const std::vector<std::array<image_t, 2>>& frame
     out.vision_delivery = m[1];
   if (std::regex_search(text, m, std::regex("decoded by its worker (\\d+) times, in line (\\d+)")))
     out.worker = std::string(m[1]) + " by the worker, " + std::string(m[2]) + " in line";
+  if (std::regex_search(text, m, std::regex("(\\d+) first images found sg-vision awake")))
+    out.worker += "; " + std::string(m[1]) + " found it awake";
 }
 
 void print(const Run& r) {
@@ -221,8 +242,9 @@ int main(int argc, char** argv) {
                  "sg-vision's vision.realtime_priority (SCHED_FIFO, memory locked; 0: off)")
       ->check(CLI::Range(0, 99));
   app.add_flag("--region-only", region_only,
-               "only the JPEG runs with the windows decoded, read directly and through LCM "
-               "(the issue's figure and its baseline)");
+               "only the JPEG runs with the windows decoded: read directly and awake for the "
+               "frames (the issue's figure), through LCM, and asleep till frames come (its "
+               "baselines)");
   CLI11_PARSE(app, argc, argv);
   try {
     const std::string dir =
@@ -231,16 +253,18 @@ int main(int argc, char** argv) {
     std::ofstream(dir + "/predictor.yaml") << "predictor:\n  period: " << 1.0 / rate << "\n";
     std::printf("rendering and encoding 60 stereo frames...\n");
     const Frames frames = render(dir + "/cams.yaml");
-    std::vector<Run> runs(region_only ? 2 : 4);
+    std::vector<Run> runs(region_only ? 3 : 5);
     runs[0].name = "JPEG, windows decoded";
     runs[1].name = "... read through LCM";
+    runs[2].name = "... asleep till frames";
     const RunSettings rs{url, dir, pairs, rate, realtime};
-    run(rs, frames.jpeg, "region", "direct", runs[0]);
-    run(rs, frames.jpeg, "region", "lcm", runs[1]);
+    run(rs, frames.jpeg, {}, runs[0]);
+    run(rs, frames.jpeg, {"region", "lcm", ""}, runs[1]);
+    run(rs, frames.jpeg, {"region", "direct", "0"}, runs[2]);
     if (!region_only) {
-      runs[2].name = "JPEG, whole frames", runs[3].name = "raw BGR8";
-      run(rs, frames.jpeg, "full", "direct", runs[2]);
-      run(rs, frames.raw, "region", "direct", runs[3]);
+      runs[3].name = "JPEG, whole frames", runs[4].name = "raw BGR8";
+      run(rs, frames.jpeg, {"full", "direct", ""}, runs[3]);
+      run(rs, frames.raw, {}, runs[4]);
     }
     std::printf(
         "\n%d pairs at %.0f Hz, one host, sg-vision %s, ms from the frames' publication "

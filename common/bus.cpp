@@ -303,14 +303,21 @@ bool Bus::drain_direct() {
   return handled;
 }
 
-bool Bus::handle(std::chrono::milliseconds timeout) {
+bool Bus::handle(std::chrono::microseconds timeout) {
   tick();
-  if (!direct_) return handle_lcm(static_cast<int>(timeout.count()));
+  timeout = std::max(timeout, std::chrono::microseconds(0));
+  if (!direct_) {  // LCM waits in whole milliseconds: round up, never to a busy loop
+    const auto ms = std::chrono::ceil<std::chrono::milliseconds>(timeout);
+    return handle_lcm(static_cast<int>(std::min<int64_t>(ms.count(), INT32_MAX)));
+  }
   // LCM's descriptor only when it has subscriptions: asking for it starts LCM's receive thread.
   const bool lcm_too = lcm_subscriptions_ > 0;
   pollfd fds[2] = {{direct_->socket.fd(), POLLIN, 0},
                    {lcm_too ? lcm_->getFileno() : -1, POLLIN, 0}};
-  const int ready = poll(fds, lcm_too ? 2 : 1, static_cast<int>(timeout.count()));
+  const auto seconds = std::chrono::duration_cast<std::chrono::seconds>(timeout);
+  const timespec wait{static_cast<time_t>(seconds.count()),
+                      static_cast<long>((timeout - seconds).count() * 1000)};
+  const int ready = ppoll(fds, lcm_too ? 2 : 1, &wait, nullptr);
   if (ready < 0) {
     if (errno == EINTR) return false;
     throw BusError(std::string("waiting for messages failed: ") + std::strerror(errno));
@@ -339,7 +346,12 @@ bool Bus::handle_lcm(int timeout_ms) {
 }
 
 void Bus::spin(const std::function<bool()>& keep_going, std::chrono::milliseconds poll) {
-  while (!shutdown_requested() && keep_going() && !end_of_log_) handle(poll);
+  spin(keep_going, [poll] { return std::chrono::microseconds(poll); });
+}
+
+void Bus::spin(const std::function<bool()>& keep_going,
+               const std::function<std::chrono::microseconds()>& wait) {
+  while (!shutdown_requested() && keep_going() && !end_of_log_) handle(wait());
   if (shutdown_requested() && !process_.empty())
     set_state(stereograsp::process_status_t::STATE_STOPPING, "asked to stop");
 }

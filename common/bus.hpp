@@ -130,18 +130,25 @@ class Bus {
   void subscribe_raw(const std::string& channel_regex,
                      std::function<void(const RawMessage&)> handler, int queue = kQueueEverySample);
 
-  /// Waits up to `timeout` for one message and dispatches it (with subscribe_direct(): LCM's
+  /// Waits up to `timeout` (to the microsecond on a bus that reads directly, else rounded up to
+  /// LCM's milliseconds) for one message and dispatches it (with subscribe_direct(): LCM's
   /// next message and every datagram waiting on the bus's own socket). Returns true when a
   /// message was handled, false on time-out (or an interrupting signal); throws BusError when
   /// LCM (or the bus's socket) fails,
   /// and, on a `file://` URL, returns false at the end of the log (see end_of_log()).
-  bool handle(std::chrono::milliseconds timeout);
+  bool handle(std::chrono::microseconds timeout);
 
   /// Dispatches messages until shutdown is requested (SIGINT, SIGTERM) or `keep_going` returns
   /// false; checks both at least every `poll`.
   void spin(
       const std::function<bool()>& keep_going = [] { return true; },
       std::chrono::milliseconds poll = std::chrono::milliseconds(100));
+
+  /// spin() that asks `wait` before each handle() how long it may wait (a program that stays
+  /// awake when a message is due, sg::vision::FrameCadence); keep `wait` short enough (100 ms)
+  /// for shutdown to be noticed.
+  void spin(const std::function<bool()>& keep_going,
+            const std::function<std::chrono::microseconds()>& wait);
 
   /// True once a `file://` bus has reached the end of its log.
   bool end_of_log() const { return end_of_log_; }

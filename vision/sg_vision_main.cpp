@@ -27,6 +27,7 @@
 #include "vision/blob_tracker.hpp"
 #include "vision/calibration_file.hpp"
 #include "vision/decode_worker.hpp"
+#include "vision/frame_cadence.hpp"
 #include "vision/frame_decoder.hpp"
 #include "vision/image_folder.hpp"
 #include "vision/image_message.hpp"
@@ -113,18 +114,40 @@ class BusFrames {
  public:
   using Message = std::shared_ptr<const image_t>;
 
-  BusFrames(StereoVision& vision, const Options& o, sg::vision::FrameDecoder::Mode mode)
+  BusFrames(StereoVision& vision, const Options& o, sg::vision::FrameDecoder::Mode mode,
+            std::chrono::microseconds busy_wait)
       : vision_(vision),
         pairer_(std::llround(o.pair_tolerance_ms * 1000)),
-        workers_{sg::vision::DecodeWorker(mode), sg::vision::DecodeWorker(mode)} {}
+        workers_{sg::vision::DecodeWorker(mode), sg::vision::DecodeWorker(mode)},
+        cadence_(busy_wait) {}
 
   void on_image(const image_t& m, const sg::ReceiveInfo& info) {
     const int64_t start = sg::now_utime();
+    const auto arrival = sg::vision::FrameCadence::Clock::now();
     const size_t side = info.channel == "CAMERA_LEFT" ? 0 : 1;
     if (const std::string e = sg::vision::image_message_error(m); !e.empty()) return drop(info, e);
     auto message = std::make_shared<const image_t>(m);
     auto pair = pairer_.add(static_cast<int>(side), m.utime, message);
-    if (!pair) return workers_[side].post(std::move(message), window(side, m));
+    if (!pair) {
+      first_arrival_ = arrival;
+      awake_ += polling_;
+      static const bool inline_decode = getenv("SG_INLINE") != nullptr;
+      if (inline_decode) return;
+      return workers_[side].post(std::move(message), window(side, m));
+    }
+    cadence_.arrived(first_arrival_);  // awake for the next pair's first image
+    {
+      static FILE* f =
+          getenv("SG_ARR")
+              ? fopen((std::string(getenv("SG_ARR")) + std::to_string(getpid())).c_str(), "w")
+              : nullptr;
+      if (f)
+        fprintf(f, "%lld\n",
+                (long long)std::chrono::duration_cast<std::chrono::microseconds>(
+                    first_arrival_.time_since_epoch())
+                    .count()),
+            fflush(f);
+    }
     const Message messages[2] = {pair->first, pair->second};
     const cv::Mat* frames[2];
     std::string error;
@@ -143,6 +166,13 @@ class BusFrames {
   }
 
   int64_t pairs() const { return pairs_; }
+  /// How long to sleep waiting for a message now: none around the next pair's due time.
+  std::chrono::microseconds wait() {
+    const std::chrono::microseconds sleep = cadence_.sleep_before_next(
+        sg::vision::FrameCadence::Clock::now(), std::chrono::milliseconds(100));
+    polling_ = sleep.count() == 0;
+    return sleep;
+  }
   void set_read_directly(bool direct) { read_directly_ = direct; }
   void report(uint64_t bus_errors) const {
     vision_.report(pairer_.unmatched(), bad_ + bus_errors);
@@ -154,11 +184,12 @@ class BusFrames {
                 delivery_.summary().c_str());
     std::printf(
         "  (the camera channels read %s; the first image of a pair decoded by its worker "
-        "%llu times, in line %llu times)\n",
+        "%llu times, in line %llu times; %llu first images found sg-vision awake)\n",
         read_directly_ ? "directly, on sg-vision's own socket on the bus's group"
                        : "through LCM's subscription",
         static_cast<unsigned long long>(workers_[0].by_worker() + workers_[1].by_worker()),
-        static_cast<unsigned long long>(workers_[0].by_caller() + workers_[1].by_caller()));
+        static_cast<unsigned long long>(workers_[0].by_caller() + workers_[1].by_caller()),
+        static_cast<unsigned long long>(awake_));
     std::printf("  of which in the image's handler (decode, track, publish): %s\n",
                 handling_.summary().c_str());
   }
@@ -190,17 +221,32 @@ class BusFrames {
   StereoVision& vision_;
   sg::vision::StereoPairer<Message> pairer_;
   sg::vision::DecodeWorker workers_[2];
+  sg::vision::FrameCadence cadence_;
+  sg::vision::FrameCadence::Clock::time_point first_arrival_{};
+  bool polling_ = false;  // the thread is polling without sleeping (busy_wait_ms)
+  uint64_t awake_ = 0;    // pairs whose first image found it so
   sg::LatencyRecord pair_to_position_, delivery_, handling_;
   uint64_t bad_ = 0;
   int64_t pairs_ = 0;
   bool read_directly_ = false;
 };
 
+/// vision.busy_wait_ms as the thread may use it: not at SCHED_FIFO, where a thread that polls
+/// keeps the kernel's own threads (ksoftirqd, which may be delivering the frame) off its core.
+std::chrono::microseconds busy_wait(const sg::vision::VisionSettings& settings) {
+  if (settings.realtime_priority > 0 && settings.busy_wait_ms > 0) {
+    spdlog::info("vision.busy_wait_ms is not used at SCHED_FIFO: sleeping until frames come");
+    return std::chrono::microseconds(0);
+  }
+  return std::chrono::microseconds(std::llround(settings.busy_wait_ms * 1000));
+}
+
 int run_lcm(sg::Bus& bus, StereoVision& vision, const Options& o,
             const sg::vision::VisionSettings& settings) {
   BusFrames frames(vision, o,
                    settings.decode == "full" ? sg::vision::FrameDecoder::Mode::kFull
-                                             : sg::vision::FrameDecoder::Mode::kRegion);
+                                             : sg::vision::FrameDecoder::Mode::kRegion,
+                   busy_wait(settings));
   auto on_image = [&](const image_t& m, const sg::ReceiveInfo& info) { frames.on_image(m, info); };
   bool direct = false;
   if (settings.camera_read == "direct") {  // this thread, not LCM's receive thread (issue 19)
@@ -213,7 +259,8 @@ int run_lcm(sg::Bus& bus, StereoVision& vision, const Options& o,
   frames.set_read_directly(direct);
   bus.announce("sg-vision");  // after subscribing: the first PROCESS_STATUS says it listens
   spdlog::info("waiting for CAMERA_LEFT and CAMERA_RIGHT");
-  bus.spin([&] { return o.max_frames == 0 || frames.pairs() < o.max_frames; });
+  bus.spin([&] { return o.max_frames == 0 || frames.pairs() < o.max_frames; },
+           [&] { return frames.wait(); });
   frames.report(bus.decode_errors());
   return 0;
 }
@@ -335,6 +382,7 @@ int main(int argc, char** argv) {
   common.flags.add(app, "--decode", "vision.decode", keys);
   common.flags.add(app, "--camera-read", "vision.camera_read", keys);
   common.flags.add(app, "--realtime-priority", "vision.realtime_priority", keys);
+  common.flags.add(app, "--busy-wait-ms", "vision.busy_wait_ms", keys);
   Options o;
   app.add_option("--source", o.source, "lcm (CAMERA_LEFT/RIGHT), video, images or v4l2")
       ->check(CLI::IsMember({"lcm", "video", "images", "v4l2"}));
