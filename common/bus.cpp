@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <mutex>
 #include <optional>
 
 #include "common/clock.hpp"
@@ -177,7 +178,11 @@ void Bus::subscribe_raw(const std::string& channel_regex,
       "cannot hold " + std::to_string(queue) + " messages for '" + channel_regex + "'";
   if (queue < 1) throw BusError(refused);  // before subscribing: nothing is left half-made
   handlers_.push_back(std::make_unique<RawHandler>(*this, std::move(handler)));
-  // LCM opens its receive socket at the first subscription; it is the one that appears.
+  // LCM opens its receive socket at the first subscription; it is the one that appears. One bus
+  // at a time, so that two in one process cannot take each other's.
+  static std::mutex first_subscriptions;
+  std::unique_lock<std::mutex> one_at_a_time(first_subscriptions, std::defer_lock);
+  if (lcm_subscriptions_ == 0) one_at_a_time.lock();
   const std::vector<int> before = lcm_subscriptions_ == 0 ? lcm_sockets() : std::vector<int>{};
   lcm::Subscription* subscription =
       lcm_->subscribe(channel_regex, &RawHandler::handleMessage, handlers_.back().get());
@@ -385,12 +390,16 @@ void Bus::announce(const std::string& process, int8_t state, const std::string& 
     start_utime_ = now_utime();
     clock_sync_ = std::make_unique<ClockSync>(process_ + "@" + host_ + ":" +
                                               std::to_string(static_cast<int32_t>(getpid())));
-    // Through LCM even on a bus that reads directly: the exchange needs receive times on this
-    // process's clock, and the direct socket stamps the kernel's (under libfaketime, or a
-    // simulated clock, they differ: every exchange came out +-400 ms +-400 ms in the lab test).
+    // The exchange needs receive times on this process's clock, taken here as the status is
+    // handled: a kernel timestamp is the kernel's clock (under libfaketime, or a simulated
+    // clock, they differ: every exchange came out +-400 ms +-400 ms in the lab test), and LCM
+    // 1.3.1's recv_utime is the kernel's for a datagram read into a fresh buffer but its own
+    // clock's after one it discarded (lcm_udpm.c keeps the buffer, and its stamp, across
+    // discarded datagrams): which one depended on whether another channel's datagram came
+    // first, and with the channel filter none does.
     subscribe<stereograsp::process_status_t>(
-        "PROCESS_STATUS", [this](const stereograsp::process_status_t& s, const ReceiveInfo& info) {
-          clock_sync_->receive(s, info.recv_utime);
+        "PROCESS_STATUS", [this](const stereograsp::process_status_t& s, const ReceiveInfo&) {
+          clock_sync_->receive(s, now_utime());
         });
   }
   next_status_ = {};
