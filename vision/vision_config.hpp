@@ -26,9 +26,10 @@ struct VisionSettings {
   /// How long before and after a stereo pair is due (from the cadence of the last ones)
   /// sg-vision polls for it without sleeping (vision/frame_cadence.hpp): waking a sleeping
   /// thread cost up to 1 ms on the lab's virtual machine. Costs 2x this in CPU time per pair;
-  /// 0: sleep until a frame arrives. Not used at SCHED_FIFO (realtime_priority): a real-time
-  /// thread that polls keeps the kernel's own threads off its core.
-  double busy_wait_ms = 1.0;
+  /// 0 (the default): sleep until a frame arrives; 1 ms did not move sg-vision's p99 there
+  /// measurably (docs/performance.md). Not used at SCHED_FIFO (realtime_priority): a
+  /// real-time thread that polls keeps the kernel's own threads off its core.
+  double busy_wait_ms = 0.0;
 };
 
 /// Reads the `vision` section: every key range-checked, any other key of the section refused
