@@ -131,23 +131,9 @@ class BusFrames {
     if (!pair) {
       first_arrival_ = arrival;
       awake_ += polling_;
-      static const bool inline_decode = getenv("SG_INLINE") != nullptr;
-      if (inline_decode) return;
       return workers_[side].post(std::move(message), window(side, m));
     }
     cadence_.arrived(first_arrival_);  // awake for the next pair's first image
-    {
-      static FILE* f =
-          getenv("SG_ARR")
-              ? fopen((std::string(getenv("SG_ARR")) + std::to_string(getpid())).c_str(), "w")
-              : nullptr;
-      if (f)
-        fprintf(f, "%lld\n",
-                (long long)std::chrono::duration_cast<std::chrono::microseconds>(
-                    first_arrival_.time_since_epoch())
-                    .count()),
-            fflush(f);
-    }
     const Message messages[2] = {pair->first, pair->second};
     const cv::Mat* frames[2];
     std::string error;
