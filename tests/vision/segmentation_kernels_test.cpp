@@ -40,36 +40,51 @@ std::vector<ColorThresholds> threshold_sets() {
 /// classify()'s bit for pixel i.
 bool bit(const std::vector<uint64_t>& bits, size_t i) { return (bits[i / 64] >> (i % 64)) & 1; }
 
+/// Every one of the 2^24 colours, as BGR pixels, made once for the test program.
+const std::vector<uint8_t>& every_colour() {
+  static const std::vector<uint8_t> bgr = [] {
+    const size_t n = size_t{1} << 24;
+    std::vector<uint8_t> v(3 * n);
+    for (size_t i = 0; i < n; ++i) {
+      v[3 * i] = static_cast<uint8_t>(i), v[3 * i + 1] = static_cast<uint8_t>(i >> 8);
+      v[3 * i + 2] = static_cast<uint8_t>(i >> 16);
+    }
+    return v;
+  }();
+  return bgr;
+}
+
+/// One case per threshold set: each a fraction of ctest's time limit in the sanitized build,
+/// where the eight in one case took over two minutes on a slow machine.
+class ClassifyEveryColour : public ::testing::TestWithParam<size_t> {};
+
 // Every one of the 2^24 colours, with every instruction set Highway compiled that this CPU has
 // and each bound tested first: classify_rows() says what is_object() says.
-TEST(ColorKernels, ClassifyIsIsObjectForEveryColour) {
-  const size_t n = size_t{1} << 24;
-  std::vector<uint8_t> bgr(3 * n);
+TEST_P(ClassifyEveryColour, ClassifyIsIsObject) {
+  const std::vector<uint8_t>& bgr = every_colour();
+  const size_t n = bgr.size() / 3;
   std::vector<uint64_t> bits(n / 64), want(n / 64);
-  for (size_t i = 0; i < n; ++i) {
-    bgr[3 * i] = static_cast<uint8_t>(i), bgr[3 * i + 1] = static_cast<uint8_t>(i >> 8);
-    bgr[3 * i + 2] = static_cast<uint8_t>(i >> 16);
-  }
   const std::vector<int64_t> targets = hwy::SupportedAndGeneratedTargets();
   ASSERT_FALSE(targets.empty());
-  for (const ColorThresholds& t : threshold_sets()) {
-    const ColorDetector d(t);
-    std::fill(want.begin(), want.end(), 0);
-    for (size_t i = 0; i < n; ++i) want[i / 64] |= uint64_t{d.is_object(&bgr[3 * i])} << (i % 64);
-    for (const int64_t target : targets) {
-      hwy::SetSupportedTargetsForTest(target);
-      for (int first = 0; first < kBounds; ++first) {
-        ClassifyRowsArgs rows{bgr.data(), 0, n, 1, n, bits.data(), 0, first};
-        const ClassifyTally tally = d.classify_rows(rows);
-        size_t wrong = 0;
-        for (size_t w = 0; w < bits.size(); ++w) wrong += std::popcount(bits[w] ^ want[w]);
-        EXPECT_EQ(wrong, 0u) << hwy::TargetName(target) << ", bound " << first << " first, r "
-                             << t.r_min << "-" << t.r_max << ", " << tally.skipped << " skipped";
-      }
+  const ColorThresholds t = threshold_sets().at(GetParam());
+  const ColorDetector d(t);
+  for (size_t i = 0; i < n; ++i) want[i / 64] |= uint64_t{d.is_object(&bgr[3 * i])} << (i % 64);
+  for (const int64_t target : targets) {
+    hwy::SetSupportedTargetsForTest(target);
+    for (int first = 0; first < kBounds; ++first) {
+      ClassifyRowsArgs rows{bgr.data(), 0, n, 1, n, bits.data(), 0, first};
+      const ClassifyTally tally = d.classify_rows(rows);
+      size_t wrong = 0;
+      for (size_t w = 0; w < bits.size(); ++w) wrong += std::popcount(bits[w] ^ want[w]);
+      EXPECT_EQ(wrong, 0u) << hwy::TargetName(target) << ", bound " << first << " first, r "
+                           << t.r_min << "-" << t.r_max << ", " << tally.skipped << " skipped";
     }
   }
   hwy::SetSupportedTargetsForTest(0);
 }
+
+INSTANTIATE_TEST_SUITE_P(ColorKernels, ClassifyEveryColour,
+                         ::testing::Range<size_t>(0, threshold_sets().size()));
 
 // The tally: the vectors the first bound skipped, the others' whole rejections, and the next
 // first bound: 64 pixels too dark (min_sum) then 64 too green (g > g_max), AVX-512's 64 a step
