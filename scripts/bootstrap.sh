@@ -44,6 +44,7 @@ packages=(
   gnuplot-nox                                      # sg-report's PNG figures (pngcairo terminal)
   iproute2 util-linux                              # ip and unshare for scripts/multicast.sh
   python3                                          # scripts/*.py and their tests
+  rt-tests                                         # cyclictest: scripts/machine_latency.py
   iptables faketime                                # fault injection: packet loss, clock skew
   openssh-client openssh-server                    # sg-lab: processes on other hosts; its tests'
                                                    # hosts (network namespaces with an sshd)
