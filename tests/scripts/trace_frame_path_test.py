@@ -1,7 +1,6 @@
 #!/usr/bin/env python3
 """scripts/trace_frame_path.py on a trace the kernel's tracer recorded (tests/fixtures/trace):
 the answers are the recorded events' own times, read off the fixture by hand."""
-import importlib.util
 import os
 import subprocess
 import sys
@@ -11,9 +10,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 SCRIPT = os.path.join(ROOT, "scripts", "trace_frame_path.py")
 FIXTURE = os.path.join(ROOT, "tests", "fixtures", "trace", "frame_path.trace")
 
-spec = importlib.util.spec_from_file_location("trace_frame_path", SCRIPT)
-tfp = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(tfp)
+sys.path.insert(0, os.path.dirname(SCRIPT))
+import trace_frame_path as tfp  # noqa: E402  (scripts/ is no package)
 
 
 class TraceFramePathTest(unittest.TestCase):
