@@ -123,6 +123,8 @@ def run(args):
                 probe.kill()
                 probe.wait()
                 sys.exit("machine_latency: %s: %s" % (args.command[0], e.strerror))
+            except KeyboardInterrupt:  # the command had it too: the histogram so far
+                status = 130
             probe.send_signal(signal.SIGINT)  # cyclictest then prints its histogram
         _, err = probe.communicate()
     if probe.returncode != 0:
