@@ -1,5 +1,8 @@
 #include "vision/decode_worker.hpp"
 
+#include <pthread.h>
+#include <sched.h>
+
 namespace sg::vision {
 
 DecodeWorker::DecodeWorker(FrameDecoder::Mode mode) : decoder_(mode), thread_([this] { run(); }) {}
@@ -18,12 +21,40 @@ void DecodeWorker::run_decode() {
   frame_ = decoder_.decode(*message_, region_, &error_);
 }
 
+void DecodeWorker::keep_off_this_cpu() {
+  const int here = sched_getcpu();
+  const int cpus = static_cast<int>(std::thread::hardware_concurrency());
+  if (here < 0 || cpus < 2 || here >= CPU_SETSIZE) return;
+  cpu_set_t others;
+  CPU_ZERO(&others);
+  for (int c = 0; c < cpus && c < CPU_SETSIZE; ++c)
+    if (c != here) CPU_SET(c, &others);
+  pthread_setaffinity_np(thread_.native_handle(), sizeof others, &others);  // a hint: may fail
+}
+
+bool DecodeWorker::awake() const {
+  return std::chrono::steady_clock::now().time_since_epoch().count() <
+         awake_until_.load();
+}
+
+void DecodeWorker::poll() {
+  while (state_.load(std::memory_order_acquire) != kPosted && awake()) {
+    std::this_thread::yield();
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (stop_) return;
+  }
+}
+
 void DecodeWorker::run() {
   for (;;) {
+    poll();
     {
       std::unique_lock<std::mutex> lock(mutex_);
-      posted_.wait(lock, [&] { return stop_ || state_.load() == kPosted; });
+      sleeping_.store(true);
+      posted_.wait(lock, [&] { return stop_ || state_.load() == kPosted || awake(); });
+      sleeping_.store(false);
       if (stop_) return;
+      if (state_.load() != kPosted) continue;  // awake again: poll
     }
     int expected = kPosted;
     if (!state_.compare_exchange_strong(expected, kWorking, std::memory_order_acquire))
@@ -31,6 +62,14 @@ void DecodeWorker::run() {
     run_decode();
     state_.store(kDone, std::memory_order_release);
   }
+}
+
+void DecodeWorker::stay_awake_until(std::chrono::steady_clock::time_point until) {
+  awake_until_.store(until.time_since_epoch().count());  // seq_cst with sleeping_
+  if (!sleeping_.load() || !awake()) return;
+  keep_off_this_cpu();
+  std::lock_guard<std::mutex> lock(mutex_);  // so the worker cannot miss the change
+  posted_.notify_one();
 }
 
 void DecodeWorker::settle() {

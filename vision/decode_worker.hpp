@@ -16,11 +16,18 @@
 /// virtual machine sometimes wakes them), and waits only for a decode under way, spinning with
 /// yields rather than sleeping, so no second wake-up lies on the frame's path.
 ///
+/// Awake when due: stay_awake_until() keeps the worker polling for a post, yielding the core,
+/// instead of sleeping, until a time (sg-vision: while a pair is due, vision.busy_wait_ms). On the
+/// lab's 2-vCPU virtual machine a sleeping worker is woken on the poster's own vCPU and preempts
+/// it, or on the other one about 0.1-0.2 ms late; an awake one takes the first image at once on
+/// the other vCPU (docs/performance.md, issue 19).
+///
 /// Lifecycle: the thread starts with the object and is joined by its destructor (after the decode
 /// under way, if any). post() and collect() are for one thread, the owner's; the frame collect()
 /// returns stays valid until the next post().
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <memory>
@@ -66,6 +73,11 @@ class DecodeWorker {
   const cv::Mat* decode(std::shared_ptr<const stereograsp::image_t> message, cv::Rect region,
                         std::string* error);
 
+  /// Until `until`, the worker polls for a post instead of sleeping (a later call moves it; a
+  /// past time lets it sleep again). Cheap to call again and again: it wakes the worker only
+  /// when it sleeps.
+  void stay_awake_until(std::chrono::steady_clock::time_point until);
+
   /// Decodes collect() found done or under way by the worker, and those it did itself.
   uint64_t by_worker() const { return by_worker_; }
   uint64_t by_caller() const { return by_caller_; }
@@ -75,6 +87,9 @@ class DecodeWorker {
   void run();         // the worker thread
   void run_decode();  // the posted message, on whichever thread took it
   void settle();      // collects (and discards) a decode still posted
+  bool awake() const;  // before the time of stay_awake_until()
+  void poll();         // the worker, awake: until a post, stop_ or that time
+  void keep_off_this_cpu();  // the worker on any core but the caller's
 
   FrameDecoder decoder_;
   std::shared_ptr<const stereograsp::image_t> message_;
@@ -82,6 +97,8 @@ class DecodeWorker {
   const cv::Mat* frame_ = nullptr;
   std::string error_;
   std::atomic<int> state_{kIdle};
+  std::atomic<int64_t> awake_until_{0};  // steady_clock ticks; 0: sleep
+  std::atomic<bool> sleeping_{false};    // the worker waits on posted_
   std::mutex mutex_;  // the worker's sleep and stop_; not on the frame's path
   std::condition_variable posted_;
   bool stop_ = false;

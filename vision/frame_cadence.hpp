@@ -6,6 +6,8 @@
 /// 1 ms in 6 % of pairs (the vCPU itself halted and woken by the host), the largest part of
 /// sg-vision's p99 (docs/performance.md). A camera is periodic, so the wait can be split: sleep
 /// until shortly before the pair is due, then poll without sleeping until it comes.
+/// (sg-vision now keeps its decode workers polling in that window and lets its reading thread
+/// sleep: a worker woken for a pair's first image was the larger delay; decode_worker.hpp.)
 ///
 ///     FrameCadence cadence(std::chrono::microseconds(1000));  // awake 1 ms either side
 ///     for (;;) {
@@ -33,8 +35,9 @@ class FrameCadence {
  public:
   using Clock = std::chrono::steady_clock;
 
-  /// `awake`: how long before and after a pair is due the thread polls without sleeping
-  /// (`vision.busy_wait_ms`); zero: it always sleeps until a message comes.
+  /// `awake`: how long before and after a pair is due sg-vision stays awake for it
+  /// (`vision.busy_wait_ms`: its decode workers poll); zero: it always sleeps until a message
+  /// comes.
   explicit FrameCadence(std::chrono::microseconds awake) : awake_(awake) {}
 
   /// A pair came at `t` (its second image's handler began).

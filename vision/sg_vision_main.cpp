@@ -119,7 +119,8 @@ class BusFrames {
       : vision_(vision),
         pairer_(std::llround(o.pair_tolerance_ms * 1000)),
         workers_{sg::vision::DecodeWorker(mode), sg::vision::DecodeWorker(mode)},
-        cadence_(busy_wait) {}
+        cadence_(busy_wait),
+        busy_wait_(busy_wait) {}
 
   void on_image(const image_t& m, const sg::ReceiveInfo& info) {
     const int64_t start = sg::now_utime();
@@ -153,11 +154,16 @@ class BusFrames {
 
   int64_t pairs() const { return pairs_; }
   /// How long to sleep waiting for a message now: none around the next pair's due time.
+  /// While a pair is due the decode workers stay awake too, so that the first image's is already
+  /// running on the other core when it comes (decode_worker.hpp).
   std::chrono::microseconds wait() {
-    const std::chrono::microseconds sleep = cadence_.sleep_before_next(
-        sg::vision::FrameCadence::Clock::now(), std::chrono::milliseconds(100));
-    polling_ = sleep.count() == 0;
-    return sleep;
+    const auto now = sg::vision::FrameCadence::Clock::now();
+    const std::chrono::microseconds sleep =
+        cadence_.sleep_before_next(now, std::chrono::milliseconds(100));
+    polling_ = sleep.count() == 0 && busy_wait_.count() > 0;
+    if (!polling_) return sleep;
+    for (auto& worker : workers_) worker.stay_awake_until(now + 2 * busy_wait_);
+    return busy_wait_;  // the workers poll; this thread sleeps until a frame, or renews that
   }
   void set_read_directly(bool direct) { read_directly_ = direct; }
   void report(uint64_t bus_errors) const {
@@ -208,8 +214,9 @@ class BusFrames {
   sg::vision::StereoPairer<Message> pairer_;
   sg::vision::DecodeWorker workers_[2];
   sg::vision::FrameCadence cadence_;
+  std::chrono::microseconds busy_wait_;  // vision.busy_wait_ms as used (busy_wait())
   sg::vision::FrameCadence::Clock::time_point first_arrival_{};
-  bool polling_ = false;  // the thread is polling without sleeping (busy_wait_ms)
+  bool polling_ = false;  // a pair is due: the workers poll (busy_wait_ms)
   uint64_t awake_ = 0;    // pairs whose first image found it so
   sg::LatencyRecord pair_to_position_, delivery_, handling_;
   uint64_t bad_ = 0;

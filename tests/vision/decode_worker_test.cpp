@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <ctime>
+#include <thread>
 
 #include "sim/camera_simulator.hpp"
 #include "tests/support/wait.hpp"
@@ -84,6 +86,41 @@ TEST(DecodeWorker, ANewPostReplacesTheLast) {
   EXPECT_EQ(cv::norm(*got, *inline_decoder.decode(*frames[1], {}, &error), cv::NORM_INF), 0.0);
   DecodeWorker abandoned(FrameDecoder::Mode::kFull);
   abandoned.post(frames[0], {});
+}
+
+/// CPU time this process has used: a worker polling adds to it, one asleep does not.
+std::chrono::microseconds process_cpu_time() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return std::chrono::seconds(t.tv_sec) + std::chrono::microseconds(t.tv_nsec / 1000);
+}
+
+// Kept awake, the worker polls (the process uses CPU while its only other thread sleeps) and
+// still decodes what FrameDecoder decodes; after that time it sleeps again (no CPU) and a post
+// still wakes it; destroying it while awake joins its thread.
+TEST(DecodeWorker, AwakeUntilATimeThenAsleep) {
+  const auto frames = lab_frames(2);
+  DecodeWorker worker(FrameDecoder::Mode::kFull);
+  const auto until = std::chrono::steady_clock::now() + 300ms;
+  worker.stay_awake_until(until);
+  const auto awake_from = process_cpu_time();
+  std::this_thread::sleep_for(200ms);
+  EXPECT_GT(process_cpu_time() - awake_from, 5ms) << "awake: polling";
+  std::this_thread::sleep_until(until + 50ms);
+  const auto asleep_from = process_cpu_time();
+  std::this_thread::sleep_for(200ms);
+  EXPECT_LT(process_cpu_time() - asleep_from, 5ms) << "asleep after the time";
+  std::string error;
+  FrameDecoder inline_decoder(FrameDecoder::Mode::kFull);
+  for (const auto& frame : frames) {
+    worker.post(frame, {});
+    ASSERT_TRUE(test::eventually([&] { return worker.taken(); }, 10s, "the worker's decode"));
+    const cv::Mat* got = worker.collect(&error);
+    ASSERT_NE(got, nullptr) << error;
+    EXPECT_EQ(cv::norm(*got, *inline_decoder.decode(*frame, {}, &error), cv::NORM_INF), 0.0);
+    worker.stay_awake_until(std::chrono::steady_clock::now() + 1h);  // destroyed awake
+  }
+  EXPECT_EQ(worker.by_worker(), frames.size());
 }
 
 }  // namespace
