@@ -22,19 +22,16 @@ void DecodeWorker::run_decode() {
 }
 
 void DecodeWorker::keep_off_this_cpu() {
+  cpu_set_t others;  // the cores this (the caller's) thread may use, but the one it is on
   const int here = sched_getcpu();
-  const int cpus = static_cast<int>(std::thread::hardware_concurrency());
-  if (here < 0 || cpus < 2 || here >= CPU_SETSIZE) return;
-  cpu_set_t others;
-  CPU_ZERO(&others);
-  for (int c = 0; c < cpus && c < CPU_SETSIZE; ++c)
-    if (c != here) CPU_SET(c, &others);
+  if (here < 0 || here >= CPU_SETSIZE || sched_getaffinity(0, sizeof others, &others) != 0) return;
+  CPU_CLR(here, &others);
+  if (CPU_COUNT(&others) == 0) return;  // one core: nowhere else to go
   pthread_setaffinity_np(thread_.native_handle(), sizeof others, &others);  // a hint: may fail
 }
 
 bool DecodeWorker::awake() const {
-  return std::chrono::steady_clock::now().time_since_epoch().count() <
-         awake_until_.load();
+  return std::chrono::steady_clock::now().time_since_epoch().count() < awake_until_.load();
 }
 
 void DecodeWorker::poll() {

@@ -84,11 +84,11 @@ class DecodeWorker {
 
  private:
   enum State : int { kIdle, kPosted, kWorking, kDone };
-  void run();         // the worker thread
-  void run_decode();  // the posted message, on whichever thread took it
-  void settle();      // collects (and discards) a decode still posted
-  bool awake() const;  // before the time of stay_awake_until()
-  void poll();         // the worker, awake: until a post, stop_ or that time
+  void run();                // the worker thread
+  void run_decode();         // the posted message, on whichever thread took it
+  void settle();             // collects (and discards) a decode still posted
+  bool awake() const;        // before the time of stay_awake_until()
+  void poll();               // the worker, awake: until a post, stop_ or that time
   void keep_off_this_cpu();  // the worker on any core but the caller's
 
   FrameDecoder decoder_;
@@ -99,7 +99,7 @@ class DecodeWorker {
   std::atomic<int> state_{kIdle};
   std::atomic<int64_t> awake_until_{0};  // steady_clock ticks; 0: sleep
   std::atomic<bool> sleeping_{false};    // the worker waits on posted_
-  std::mutex mutex_;  // the worker's sleep and stop_; not on the frame's path
+  std::mutex mutex_;                     // the worker's sleep and stop_; not on the frame's path
   std::condition_variable posted_;
   bool stop_ = false;
   uint64_t by_worker_ = 0, by_caller_ = 0;

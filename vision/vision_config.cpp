@@ -27,7 +27,7 @@ VisionSettings read_vision_settings(const Config& config) {
   c.number("realtime_priority", s.realtime_priority, Range::closed(0, 99),
            "SCHED_FIFO priority with memory locked (needs CAP_SYS_NICE; 0: off)");
   c.number("busy_wait_ms", s.busy_wait_ms, Range::closed(0, 50),
-           "ms before and after a pair is due that the decode workers poll for it awake (0: never)");
+           "ms either side of when a pair is due that the decode workers poll (0: never)");
   band(c, "r_range", k.r_min, k.r_max, "normalized r = R/(R+G+B) of the ball (eq. 7)");
   band(c, "g_range", k.g_min, k.g_max, "normalized g of the ball");
   band(c, "b_range", k.b_min, k.b_max, "normalized b of the ball");
