@@ -101,7 +101,7 @@ class DecodeWorker {
   std::atomic<bool> sleeping_{false};    // the worker waits on posted_
   std::mutex mutex_;                     // the worker's sleep and stop_; not on the frame's path
   std::condition_variable posted_;
-  bool stop_ = false;
+  std::atomic<bool> stop_{false};  // set under mutex_ (for the sleep's wake-up), read anywhere
   uint64_t by_worker_ = 0, by_caller_ = 0;
   std::thread thread_;  // last: starts once everything above exists
 };
