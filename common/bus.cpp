@@ -163,6 +163,7 @@ Bus::~Bus() {
 }
 
 bool Bus::publish_raw(const std::string& channel, const void* data, int size) {
+  last_handed_utime_ = now_utime();
   if (lcm_->publish(channel, data, static_cast<unsigned>(size)) == 0) {
     rates_.sent(channel);
     return true;

@@ -182,6 +182,11 @@ class Bus {
   uint64_t handler_errors() const { return handler_errors_; }
   uint64_t refused_inputs() const { return refused_inputs_; }
   uint64_t publish_errors() const { return publish_errors_; }
+  /// When the last publish() handed its bytes to LCM (sg::now_utime(), read just before LCM's
+  /// send): the moment a message leaves its publisher. On one host the send then delivers the
+  /// datagram to the host's own subscribers before it returns, in the publisher's thread, and a
+  /// subscriber woken on its core may run first (issue 19, docs/performance.md).
+  int64_t last_handed_utime() const { return last_handed_utime_; }
   /// The newest refusal or failure, one line ("" when none).
   const std::string& last_problem() const { return last_problem_; }
   /// The status PROCESS_STATUS carries at `utime`: counts, state, per-channel counts and rates
@@ -254,6 +259,7 @@ class Bus {
   uint64_t handler_errors_ = 0;
   uint64_t refused_inputs_ = 0;
   uint64_t publish_errors_ = 0;
+  int64_t last_handed_utime_ = 0;
   std::string last_problem_;
   std::string process_, host_;  // as announce()d; "" = no PROCESS_STATUS
   int8_t state_ = stereograsp::process_status_t::STATE_READY;

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
@@ -64,9 +65,15 @@ class StereoVision {
         step_(settings.tracker, size, std::move(calibration), settings.match),
         publish_images_(publish_images) {}
 
-  /// Tracks a pair and publishes OBJECT_POSITION (when seen), then BLOB_LEFT and BLOB_RIGHT;
-  /// returns when OBJECT_POSITION went out (sg::now_utime(); 0 when there was none).
-  int64_t process(const cv::Mat& left, const cv::Mat& right, int64_t frame_number, int64_t utime) {
+  /// When a pair's OBJECT_POSITION went out (sg::now_utime(); 0 when there was none): handed to
+  /// the bus, and the bus's publish() returned (sg::Bus::last_handed_utime()).
+  struct Published {
+    int64_t handed = 0, returned = 0;
+  };
+
+  /// Tracks a pair and publishes OBJECT_POSITION (when seen), then BLOB_LEFT and BLOB_RIGHT.
+  Published process(const cv::Mat& left, const cv::Mat& right, int64_t frame_number,
+                    int64_t utime) {
     if (publish_images_) {
       const cv::Mat* images[2] = {&left, &right};
       for (int i = 0; i < 2; ++i)
@@ -76,8 +83,11 @@ class StereoVision {
     }
     const sg::vision::StereoOutput out = step_.process(left, right, frame_number, utime);
     // The position first, so that a viewer drawing on the blobs has the frame's position too.
-    int64_t published = 0;
-    if (out.position) bus_.publish("OBJECT_POSITION", *out.position), published = sg::now_utime();
+    Published published;
+    if (out.position) {
+      bus_.publish("OBJECT_POSITION", *out.position);
+      published = {bus_.last_handed_utime(), sg::now_utime()};
+    }
     bus_.publish("BLOB_LEFT", out.blob[0]);
     bus_.publish("BLOB_RIGHT", out.blob[1]);
     return published;
@@ -106,6 +116,13 @@ class StereoVision {
   bool publish_images_;
 };
 
+/// CPU time of the whole process, every thread's, in seconds.
+double process_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
 /// Stereo pairs from CAMERA_LEFT and CAMERA_RIGHT: paired as messages, each decoded where its
 /// tracker will look (frame_decoder.hpp); the pair's first image on its camera's DecodeWorker as
 /// it arrives, the second in line when it completes the pair, so the two decode at once. Times
@@ -120,7 +137,9 @@ class BusFrames {
         pairer_(std::llround(o.pair_tolerance_ms * 1000)),
         workers_{sg::vision::DecodeWorker(mode), sg::vision::DecodeWorker(mode)},
         cadence_(busy_wait),
-        busy_wait_(busy_wait) {}
+        busy_wait_(busy_wait),
+        started_(steady_clock::now()),
+        started_cpu_s_(process_cpu_seconds()) {}
 
   void on_image(const image_t& m, const sg::ReceiveInfo& info) {
     const int64_t start = sg::now_utime();
@@ -132,8 +151,14 @@ class BusFrames {
     if (!pair) {
       first_arrival_ = arrival;
       awake_ += polling_;
-      return workers_[side].post(std::move(message), window(side, m));
+      workers_[side].post(std::move(message), window(side, m));
+      // The pair's second image is decoded here: the other worker has nothing to take until the
+      // next pair, and polling it would share the first image's core with its decode.
+      workers_[1 - side].stay_awake_until({});
+      first_waiting_ = true;
+      return;
     }
+    first_waiting_ = false;
     cadence_.arrived(first_arrival_);  // awake for the next pair's first image
     const Message messages[2] = {pair->first, pair->second};
     const cv::Mat* frames[2];
@@ -142,33 +167,36 @@ class BusFrames {
     if (!frames[side]) return drop(info, error);
     if (!(frames[1 - side] = collect(1 - side, messages[1 - side], &error)))
       return drop(info, error);
-    const int64_t published =
+    const auto published =
         vision_.process(*frames[0], *frames[1], pair->first->frame_number, pair->first->utime);
-    if (published != 0) {  // the stopwatch stops at OBJECT_POSITION, not at the blobs after it
-      pair_to_position_.add(published - info.recv_utime);
+    if (published.handed != 0) {  // the stopwatch stops at OBJECT_POSITION, not the blobs after
+      pair_to_position_.add(published.handed - info.recv_utime);
       delivery_.add(start - info.recv_utime);
-      handling_.add(published - start);
+      handling_.add(published.handed - start);
+      pair_to_return_.add(published.returned - info.recv_utime);
     }
     ++pairs_;
   }
 
   int64_t pairs() const { return pairs_; }
   /// How long to sleep waiting for a message now: none around the next pair's due time.
-  /// While a pair is due the decode workers stay awake too, so that the first image's is already
-  /// running on the other core when it comes (decode_worker.hpp).
+  /// While a pair is due, and until its first image comes, the decode workers stay awake too, so
+  /// that the first image's is already running on the other core when it comes
+  /// (decode_worker.hpp).
   std::chrono::microseconds wait() {
     const auto now = sg::vision::FrameCadence::Clock::now();
     const std::chrono::microseconds sleep =
         cadence_.sleep_before_next(now, std::chrono::milliseconds(100));
     polling_ = sleep.count() == 0 && busy_wait_.count() > 0;
     if (!polling_) return sleep;
-    for (auto& worker : workers_) worker.stay_awake_until(now + 2 * busy_wait_);
+    if (!first_waiting_)
+      for (auto& worker : workers_) worker.stay_awake_until(now + 2 * busy_wait_);
     return busy_wait_;  // the workers poll; this thread sleeps until a frame, or renews that
   }
   void set_read_directly(bool direct) { read_directly_ = direct; }
   void report(uint64_t bus_errors) const {
     vision_.report(pairer_.unmatched(), bad_ + bus_errors);
-    std::printf("second image received -> OBJECT_POSITION published: %s (decode: %s)\n",
+    std::printf("second image received -> OBJECT_POSITION handed to the bus: %s (decode: %s)\n",
                 pair_to_position_.summary().c_str(),
                 workers_[0].decoder().mode() == sg::vision::FrameDecoder::Mode::kRegion ? "region"
                                                                                         : "full");
@@ -184,6 +212,15 @@ class BusFrames {
         static_cast<unsigned long long>(awake_));
     std::printf("  of which in the image's handler (decode, track, publish): %s\n",
                 handling_.summary().c_str());
+    std::printf(
+        "second image received -> the bus's publish() of OBJECT_POSITION returned (its delivery "
+        "to this host's subscribers included): %s\n",
+        pair_to_return_.summary().c_str());
+    const double cpu_s = process_cpu_seconds() - started_cpu_s_;
+    const double wall_s = duration<double>(steady_clock::now() - started_).count();
+    std::printf("CPU time: %.2f s in %.1f s (%.1f %% of one core), %.2f ms a pair\n", cpu_s,
+                wall_s, 100 * cpu_s / std::max(wall_s, 1e-9),
+                pairs_ ? 1000 * cpu_s / static_cast<double>(pairs_) : 0.0);
   }
 
  private:
@@ -216,12 +253,15 @@ class BusFrames {
   sg::vision::FrameCadence cadence_;
   std::chrono::microseconds busy_wait_;  // vision.busy_wait_ms as used (busy_wait())
   sg::vision::FrameCadence::Clock::time_point first_arrival_{};
-  bool polling_ = false;  // a pair is due: the workers poll (busy_wait_ms)
+  bool polling_ = false;        // a pair is due: the workers poll (busy_wait_ms)
+  bool first_waiting_ = false;  // a pair's first image is posted, its second not yet come
   uint64_t awake_ = 0;    // pairs whose first image found it so
-  sg::LatencyRecord pair_to_position_, delivery_, handling_;
+  sg::LatencyRecord pair_to_position_, delivery_, handling_, pair_to_return_;
   uint64_t bad_ = 0;
   int64_t pairs_ = 0;
   bool read_directly_ = false;
+  steady_clock::time_point started_;
+  double started_cpu_s_;  // the process's CPU time (every thread's) then
 };
 
 /// vision.busy_wait_ms as the thread may use it: not at SCHED_FIFO, where a thread that polls

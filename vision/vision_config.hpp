@@ -24,12 +24,14 @@ struct VisionSettings {
   /// (common/realtime.hpp); 0: the ordinary scheduler.
   int realtime_priority = 0;
   /// How long before and after a stereo pair is due (from the cadence of the last ones)
-  /// sg-vision polls for it without sleeping (vision/frame_cadence.hpp): waking a sleeping
-  /// thread cost up to 1 ms on the lab's virtual machine. Costs 2x this in CPU time per pair;
-  /// 0 (the default): sleep until a frame arrives; 1 ms did not move sg-vision's p99 there
-  /// measurably (docs/performance.md). Not used at SCHED_FIFO (realtime_priority): a
-  /// real-time thread that polls keeps the kernel's own threads off its core.
-  double busy_wait_ms = 0.0;
+  /// sg-vision's decode workers poll for its first image without sleeping, off the reading
+  /// thread's core (vision/frame_cadence.hpp, vision/decode_worker.hpp): a worker woken from
+  /// sleep on the lab's virtual machine lands on the reader's core and preempts it, or comes
+  /// 0.1-1 ms late. Costs the polling's CPU time, about the intervals' spread plus 2x this per
+  /// pair (docs/performance.md, issue 19); 0: the workers sleep until a frame arrives. Not used
+  /// at SCHED_FIFO (realtime_priority): a real-time thread that polls keeps the kernel's own
+  /// threads off its core.
+  double busy_wait_ms = 1.0;
 };
 
 /// Reads the `vision` section: every key range-checked, any other key of the section refused

@@ -57,6 +57,25 @@ TEST(Bus, TypedPublishSubscribeOverMemq) {
   EXPECT_GT(infos[0].recv_utime, 0);
 }
 
+// last_handed_utime() is read as publish() hands the bytes to LCM: after the call began, before
+// it returned, and no later than the message's receipt (memq:// stamps it as LCM takes it); 0
+// before any publish.
+TEST(Bus, PublishRecordsWhenItHandedTheMessageToLcm) {
+  Bus bus("memq://");
+  EXPECT_EQ(bus.last_handed_utime(), 0);
+  std::vector<ReceiveInfo> infos;
+  bus.subscribe<point3_t>("OBJECT_POSITION",
+                          [&](const point3_t&, const ReceiveInfo& info) { infos.push_back(info); });
+  const int64_t before = now_utime();
+  ASSERT_TRUE(bus.publish("OBJECT_POSITION", make_point(1000, 0.25)));
+  const int64_t after = now_utime();
+  EXPECT_GE(bus.last_handed_utime(), before);
+  EXPECT_LE(bus.last_handed_utime(), after);
+  ASSERT_TRUE(bus.handle(100ms));
+  ASSERT_EQ(infos.size(), 1u);
+  EXPECT_LE(bus.last_handed_utime(), infos[0].recv_utime);
+}
+
 // A subscription holds kQueueEverySample messages while its handler is busy, not LCM's 30: udpm
 // drops what comes beyond a subscription's queue (memq:// does not, so this needs the network).
 TEST(Bus, QueueHoldsEverySampleOfABurst) {
