@@ -10,7 +10,8 @@ or a stretch in which a running thread shows no event at all (its vCPU held by t
         scripts/multicast.sh run build/bin/frame_path_latency --region-only
     (system calls are traced too, so that a running thread's silences mean something: the trace
     is then ten times larger, --no-syscalls leaves them out; --buffer-mb sets the per-CPU ring,
-    which drops the oldest events when full: a long run needs a large one)
+    which drops the oldest events when full: a long run needs a large one; --softirqs adds the
+    softirqs, what a send does on one host before it returns)
   analyze: the pairs of a recorded trace (or of `cat /sys/kernel/tracing/trace`)
     scripts/trace_frame_path.py analyze /tmp/fp.trace [--over-us 1500] [--process sg-vision]
 
@@ -126,6 +127,23 @@ def find_pairs(events, image_bytes, process):
     return out
 
 
+def after_send(events, pairs):
+    """For each pair, the time from its OBJECT_POSITION entering the loopback to the sending
+    thread's next datagram (sg-vision's BLOB_LEFT), in us; None when there is none. On one host
+    the send delivers the datagram to the host's subscribers in the sender's thread, and one woken
+    on its CPU may run before the send returns: sg-vision's own figure stops before that time
+    (Bus::last_handed_utime), the "to publish() returning" one after it."""
+    sent = [(e.t, e.pid) for e in events if e.event == "netif_rx"]
+    times = [t for t, _ in sent]
+    out = []
+    for _, position, pid in pairs:
+        i = bisect.bisect_right(times, position)
+        while i < len(sent) and sent[i][1] != pid:
+            i += 1
+        out.append((sent[i][0] - position) * 1e6 if i < len(sent) else None)
+    return out
+
+
 class CpuEvents:
     """Each CPU's event times, for the silences of a running thread."""
 
@@ -200,6 +218,11 @@ def analyze(args):
         print("run %d: %d pairs, second image -> OBJECT_POSITION p50 %.0f us, p99 %.0f us, max %.0f us;"
               " %d over %.0f us" % (k + 1, len(run), percentile(lat, 0.5), percentile(lat, 0.99),
                                     max(lat), len(slow), args.over_us))
+        gaps = [g for g in after_send(events, run) if g is not None]
+        if gaps:
+            print("  OBJECT_POSITION into the loopback -> the sender's next datagram: p50 %.0f us,"
+                  " p99 %.0f us, max %.0f us" % (percentile(gaps, 0.5), percentile(gaps, 0.99),
+                                                  max(gaps)))
         for l, (sec, pos, pid) in sorted(slow, reverse=True)[:args.show]:
             causes = explain(timeline, cpu_events, sec, pos, args.process, args.quiet_us)
             print("  %.6f  %6.0f us  %s" % (sec, l, "; ".join(causes) if causes else "no cause seen"))
@@ -234,6 +257,8 @@ def record(args):
     events = ["sched:sched_switch", "sched:sched_wakeup", "net:netif_rx"]
     if not args.no_syscalls:
         events += ["raw_syscalls:sys_enter", "raw_syscalls:sys_exit"]
+    if args.softirqs:
+        events += ["irq:softirq_entry", "irq:softirq_exit"]
     write("tracing_on", "0")
     write("trace", "")
     write("trace_clock", "mono")
@@ -262,6 +287,8 @@ def main():
     r = sub.add_parser("record", help="run a command with the frame path traced (root)")
     r.add_argument("out", help="where the trace goes (text)")
     r.add_argument("--buffer-mb", type=int, default=256, help="per-CPU ring buffer (MiB)")
+    r.add_argument("--softirqs", action="store_true",
+                   help="the softirqs too (what a send does before it returns)")
     r.add_argument("--no-syscalls", action="store_true",
                    help="leave system calls out (a smaller trace; silences are then not judged)")
     r.epilog = "then -- COMMAND (default: frame_path_latency --region-only)"

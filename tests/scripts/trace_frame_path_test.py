@@ -51,6 +51,14 @@ class TraceFramePathTest(unittest.TestCase):
                                      "sg-vision", 300),
                          ["sg-vision-5711 preempted on CPU 0 by sg-vision-5714"])
 
+    # From each OBJECT_POSITION (130 bytes) into the loopback to sg-vision's next datagram
+    # (BLOB_LEFT, 293 bytes): 27636.281660 -> .281739, .333937 -> .333975, 27652.644121 ->
+    # .644178, .695619 -> .695843. In the first, sg-predictor, woken by the send on sg-vision's
+    # CPU (27636.281666), runs before sg-vision's next system call.
+    def test_after_the_send(self):
+        self.assertEqual([round(g) for g in tfp.after_send(self.events, self.pairs)],
+                         [79, 38, 57, 224])
+
     # Every wake-up of one sg-vision thread by another in the fixture was on the waker's CPU.
     def test_worker_placement(self):
         self.assertEqual(tfp.worker_placement(self.events, "sg-vision"), (4, 0))
