@@ -50,8 +50,8 @@ packages=(
                                                    # hosts (network namespaces with an sshd)
 )
 # Only for scripts/fuzz.sh: clang with libFuzzer, ASan and UBSan runtimes (libclang-rt-dev),
-# and llvm-symbolizer (llvm) for file:line in sanitizer reports.
-[ "$with_clang" -eq 0 ] || packages+=(clang libclang-rt-dev llvm)
+# llvm-symbolizer (llvm) for file:line in sanitizer reports, and lld, the sanitized build's linker.
+[ "$with_clang" -eq 0 ] || packages+=(clang libclang-rt-dev llvm lld)
 
 missing=()
 for p in "${packages[@]}"; do
