@@ -201,7 +201,8 @@ void run(const RunSettings& rs, const std::vector<std::array<image_t, 2>>& frame
   std::smatch m;
   if (std::regex_search(text, m, std::regex("OBJECT_POSITION handed to the bus: ([^\n]*)")))
     out.vision_own = m[1];
-  if (std::regex_search(text, m, std::regex("publish\\(\\) of OBJECT_POSITION returned [^:]*: ([^\n]*)")))
+  if (std::regex_search(text, m,
+                        std::regex("publish\\(\\) of OBJECT_POSITION returned [^:]*: ([^\n]*)")))
     out.vision_returned = m[1];
   if (std::regex_search(text, m, std::regex("handler \\([^)]*\\): ([^\n]*)")))
     out.vision_handler = m[1];

@@ -66,7 +66,7 @@ class StereoVision {
         publish_images_(publish_images) {}
 
   /// When a pair's OBJECT_POSITION went out (sg::now_utime(); 0 when there was none): handed to
-  /// the bus, and the bus's publish() returned (sg::Bus::last_handed_utime()).
+  /// the bus (sg::Bus::last_handed_utime()), and the bus's publish() returned.
   struct Published {
     int64_t handed = 0, returned = 0;
   };
@@ -218,8 +218,8 @@ class BusFrames {
         pair_to_return_.summary().c_str());
     const double cpu_s = process_cpu_seconds() - started_cpu_s_;
     const double wall_s = duration<double>(steady_clock::now() - started_).count();
-    std::printf("CPU time: %.2f s in %.1f s (%.1f %% of one core), %.2f ms a pair\n", cpu_s,
-                wall_s, 100 * cpu_s / std::max(wall_s, 1e-9),
+    std::printf("CPU time: %.2f s in %.1f s (%.1f %% of one core), %.2f ms a pair\n", cpu_s, wall_s,
+                100 * cpu_s / std::max(wall_s, 1e-9),
                 pairs_ ? 1000 * cpu_s / static_cast<double>(pairs_) : 0.0);
   }
 
@@ -255,7 +255,7 @@ class BusFrames {
   sg::vision::FrameCadence::Clock::time_point first_arrival_{};
   bool polling_ = false;        // a pair is due: the workers poll (busy_wait_ms)
   bool first_waiting_ = false;  // a pair's first image is posted, its second not yet come
-  uint64_t awake_ = 0;    // pairs whose first image found it so
+  uint64_t awake_ = 0;          // pairs whose first image found it so
   sg::LatencyRecord pair_to_position_, delivery_, handling_, pair_to_return_;
   uint64_t bad_ = 0;
   int64_t pairs_ = 0;
