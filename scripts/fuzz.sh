@@ -91,6 +91,19 @@ for t in "${targets[@]}"; do
   printf '%-16s %12s %10s %8s %8s  %s\n' "$t" "${runs:-?}" "${speed:-?}" "${cov:-?}" "$crashes" "$result"
 done
 if [ "$failed" -ne 0 ]; then
+  # What each failed target reported, so a log that is gone with its machine (CI) still says why,
+  # and the crashing input itself (base64, up to 8 KiB) so it can be reproduced elsewhere.
+  for t in "${targets[@]}"; do
+    log="$build/logs/$t.log"
+    grep -q -E 'ERROR: (AddressSanitizer|LeakSanitizer|libFuzzer)|runtime error:|fuzz check failed' \
+      "$log" || [ "$(cat "$build/logs/$t.status")" -ne 0 ] || continue
+    echo "fuzz.sh: $t's report:" >&2
+    grep -m 1 -B 2 -A 12 -E 'ERROR: |runtime error:|fuzz check failed' "$log" >&2 || tail -n 15 "$log" >&2
+    find "$build/artifacts/$t" -type f -newer "$build/logs/$t.start" | head -n 1 | while read -r input; do
+      echo "fuzz.sh: $input, base64:" >&2
+      head -c 8192 "$input" | base64 >&2
+    done
+  done
   echo "fuzz.sh: a target failed; crashing inputs are in $build/artifacts/" >&2
   exit 1
 fi

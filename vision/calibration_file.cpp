@@ -47,6 +47,18 @@ void write_camera(cv::FileStorage& fs, const std::string& name, const CameraMode
 /// its type throws).
 bool present(const YAML::Node& node) { return node.IsDefined() && !node.IsNull(); }
 
+/// Whether `text` is one line of printable text no longer than kCalibrationTextMax: what
+/// FileStorage writes back as it was read (it stops at a NUL byte, and refuses strings over
+/// 4096 bytes; fuzz/calibration_fuzz found a date holding NULs that came back shorter).
+bool is_one_line_of_text(const std::string& text) {
+  if (text.size() > kCalibrationTextMax) return false;
+  for (const char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte < 0x20 || byte == 0x7f) return false;
+  }
+  return true;
+}
+
 /// "FILE:LINE: key 'KEY' ": where an error is (the line of the node when it has one).
 std::string where(const std::string& path, const YAML::Node& node, const std::string& key) {
   const YAML::Mark mark = node.IsDefined() ? node.Mark() : YAML::Mark::null_mark();
@@ -141,6 +153,10 @@ YAML::Node parse_file(const std::string& path) {
 }  // namespace
 
 void write_calibration(const std::string& path, const StereoCalibration& c) {
+  for (const auto& [key, text] : {std::pair{"source", &c.source}, {"date", &c.date}}) {
+    if (!is_one_line_of_text(*text))
+      throw CalibrationError(path + ": " + key + " " + kCalibrationTextRule);
+  }
   const std::string temporary = path + ".tmp";
   try {
     cv::FileStorage fs(temporary, cv::FileStorage::WRITE | cv::FileStorage::FORMAT_YAML);
@@ -191,7 +207,10 @@ StereoCalibration read_calibration(const std::string& path) {
     c.left = read_camera(root["camera_left"], path, "camera_left", width, height, &c.rms_left);
     c.right = read_camera(root["camera_right"], path, "camera_right", width, height, &c.rms_right);
     for (auto [key, out] : {std::pair{"source", &c.source}, {"date", &c.date}}) {
-      if (present(root[key])) *out = scalar<std::string>(root[key], path, key, "a string");
+      if (!present(root[key])) continue;
+      *out = scalar<std::string>(root[key], path, key, "a string");
+      if (!is_one_line_of_text(*out))
+        throw CalibrationError(where(path, root[key], key) + kCalibrationTextRule);
     }
     return c;
   } catch (const YAML::Exception& e) {  // e.g. a node used as a map that is not one

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 
@@ -28,11 +29,18 @@ struct StereoCalibration {
 /// The file format's version; read_calibration refuses other versions.
 inline constexpr int kCalibrationFormatVersion = 1;
 
+/// The longest `source` or `date` a calibration file holds, in bytes.
+inline constexpr std::size_t kCalibrationTextMax = 1024;
+/// What `source` and `date` must be; read_calibration and write_calibration refuse other text.
+inline constexpr const char* kCalibrationTextRule =
+    "must be one line of text (no control characters, at most 1024 bytes)";
+
 /// Writes YAML that OpenCV's FileStorage reads: format_version, date, source, image size and,
 /// per camera (`camera_left`, `camera_right`), K, distortion (k1 k2 p1 p2 k3), R and t (robot base
 /// frame to camera frame), P = K [R|t], rms; and `T_robot_camera_left`, the left camera's pose in
 /// the robot frame (4x4). Written to a temporary file and renamed, so a failure never leaves a
-/// partial file over a good one.
+/// partial file over a good one. Throws CalibrationError when `source` or `date` is not
+/// kCalibrationTextRule's text, or the file cannot be written.
 void write_calibration(const std::string& path, const StereoCalibration& calibration);
 
 /// Reads a file written by write_calibration (with yaml-cpp: OpenCV's FileStorage parser crashes

@@ -95,6 +95,41 @@ TEST(CalibrationFile, BadKeysAreNamed) {
   }
 }
 
+// source and date are one line of text: a date holding NUL bytes, which FileStorage wrote back
+// cut at the first (fuzz/calibration_fuzz), is refused naming the key; the writer refuses what
+// the reader would; 1024 bytes round trip and 1025 do not.
+TEST(CalibrationFile, SourceAndDateAreOneLineOfText) {
+  const std::string dir = test::make_temp_dir();
+  write_calibration(dir + "/good.yaml", sample());
+  std::string nul = test::read_text(dir + "/good.yaml");
+  const size_t date = nul.find("date: \"");
+  ASSERT_NE(date, std::string::npos);
+  nul.insert(date + 10, std::string("?\0\0\0", 4));
+  std::ofstream(dir + "/nul.yaml", std::ios::binary) << nul;
+  try {
+    read_calibration(dir + "/nul.yaml");
+    FAIL() << "accepted";
+  } catch (const CalibrationError& e) {
+    EXPECT_NE(std::string(e.what()).find(":4: key 'date' must be one line of text"),
+              std::string::npos)
+        << e.what();
+  }
+  for (const std::string& bad : {std::string("two\nlines"), std::string("tab\there"),
+                                 std::string("del\x7f"), std::string(1025, 'a')}) {
+    StereoCalibration c = sample();
+    c.source = bad;
+    EXPECT_THROW(write_calibration(dir + "/bad.yaml", c), CalibrationError) << bad.size();
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir + "/bad.yaml"));
+  StereoCalibration longest = sample();
+  longest.source = std::string(1024, 'a');
+  longest.date = "2026-12-07T18:00:00Z";
+  write_calibration(dir + "/longest.yaml", longest);
+  const StereoCalibration back = read_calibration(dir + "/longest.yaml");
+  EXPECT_EQ(back.source, longest.source);
+  EXPECT_EQ(back.date, longest.date);
+}
+
 // A failed write leaves the good file that was there.
 TEST(CalibrationFile, FailedWriteKeepsTheOldFile) {
   const std::string dir = test::make_temp_dir();
