@@ -8,8 +8,10 @@
 /// the bus (sg-vision's own latency, issue 19).
 ///
 ///     sg::vision::BusFrames frames(publisher, {.pair_tolerance_us = 5000});
-///     bus.subscribe<image_t>("CAMERA_LEFT", [&](auto& m, auto& info) { frames.on_image(m, info);
-///     }); bus.spin([&] { return true; }, [&] { return frames.wait(); });
+///     auto on_image = [&](const image_t& m, const sg::ReceiveInfo& i) { frames.on_image(m, i); };
+///     bus.subscribe<image_t>("CAMERA_LEFT", on_image);
+///     bus.subscribe<image_t>("CAMERA_RIGHT", on_image);
+///     bus.spin([&] { return true; }, [&] { return frames.wait(); });
 ///     frames.report(bus.decode_errors());
 ///
 /// Bad images (image_message_error(), or undecodable) are dropped, counted and logged (the

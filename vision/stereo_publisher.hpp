@@ -4,9 +4,9 @@
 /// publishes what it found, OBJECT_POSITION first (when the ball is placed in 3D), then
 /// BLOB_LEFT and BLOB_RIGHT, so that a viewer drawing on the blobs has the frame's position too.
 ///
-///     sg::vision::StereoPublisher vision(bus, settings, {640, 480}, read_calibration(path),
-///     false); const auto sent = vision.process(left, right, frame_number, capture_utime); if
-///     (sent.handed != 0) latency.add(sent.handed - second_image_received_utime);
+///     sg::vision::StereoPublisher vision(bus, settings, {640, 480}, calibration, false);
+///     const auto sent = vision.process(left, right, frame_number, capture_utime);
+///     if (sent.handed != 0) latency.add(sent.handed - second_image_received_utime);
 
 #include <cstdint>
 #include <opencv2/core.hpp>
