@@ -116,9 +116,12 @@ TEST(CalibrationFile, SourceAndDateAreOneLineOfText) {
   }
   for (const std::string& bad : {std::string("two\nlines"), std::string("tab\there"),
                                  std::string("del\x7f"), std::string(1025, 'a')}) {
-    StereoCalibration c = sample();
-    c.source = bad;
-    EXPECT_THROW(write_calibration(dir + "/bad.yaml", c), CalibrationError) << bad.size();
+    for (std::string StereoCalibration::*text :
+         {&StereoCalibration::source, &StereoCalibration::date}) {
+      StereoCalibration c = sample();
+      c.*text = bad;
+      EXPECT_THROW(write_calibration(dir + "/bad.yaml", c), CalibrationError) << bad.size();
+    }
   }
   EXPECT_FALSE(std::filesystem::exists(dir + "/bad.yaml"));
   StereoCalibration longest = sample();
