@@ -164,7 +164,10 @@ int main(int argc, char** argv) {
     sg::load_common(common);
     sg::install_shutdown_handlers();
     sg::Bus bus(common.lcm_url);
-    if (*status_cmd) return status(bus, follow, timeout);
+    if (*status_cmd) {
+      sg::auth::guard_if_key(bus, app.get_name(), key_options);
+      return status(bus, follow, timeout);
+    }
     Cmd c = make_command(Cmd::MODE_STOP, speed);
     if (*move) {
       c.mode = Cmd::MODE_CARTESIAN;
@@ -186,6 +189,7 @@ int main(int argc, char** argv) {
     }
     c.take_over = take_over;
     return sg::auth::with_lab_access(app.get_name(), key_options, [&](sg::auth::LabAccess& lab) {
+      lab.guard(bus);
       return send(bus, lab, c, timeout);
     });
   });

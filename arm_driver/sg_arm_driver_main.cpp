@@ -62,6 +62,7 @@ int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
         const sg::arm::ArmDriverSettings& s, sg::auth::LabAccess& lab) {
   sg::install_shutdown_handlers();
   sg::Bus bus(url);
+  lab.guard(bus);
   if (!wait_for_device(bus, s)) return 0;  // asked to stop while waiting
   sg::arm::DriverSettings settings = s.driver;
   settings.start_utime = sg::now_utime();  // ARM_STATUS.driver_start_utime: a restart shows

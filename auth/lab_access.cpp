@@ -29,13 +29,37 @@ LabAccess::LabAccess(std::optional<LabKey> key, std::string sender, VerifierSett
   }
 }
 
+std::shared_ptr<DataGuard> LabAccess::guard(Bus& bus) const {
+  if (!key_) return nullptr;
+  if (bus.url().rfind("file://", 0) == 0) {
+    spdlog::info("reading a recorded log ({}): its messages are believed as recorded", bus.url());
+    return nullptr;
+  }
+  auto guard = std::make_shared<DataGuard>(credentials_from_lab_key(*key_, identity()));
+  bus.set_guard(guard);
+  return guard;
+}
+
+std::shared_ptr<DataGuard> guard_if_key(Bus& bus, const std::string& program,
+                                        const KeyOptions& options) {
+  if (options.insecure) return nullptr;
+  try {
+    const std::string path = options.path.empty() ? default_key_path() : options.path;
+    return LabAccess(LabKey::load(path), instance_name(program)).guard(bus);
+  } catch (const LabKeyError& e) {
+    spdlog::warn("{}; showing what arrives without checking who sent it", e.what());
+    return nullptr;
+  }
+}
+
 int with_lab_access(const std::string& program, const KeyOptions& options,
                     const std::function<int(LabAccess&)>& body) {
   std::optional<LabKey> key;
   if (options.insecure) {
     spdlog::warn(
-        "INSECURE: running without a lab key (--insecure-no-key): commands go unsigned and "
-        "unsigned ones are obeyed; anyone on the network can command the arm");
+        "INSECURE: running without a lab key (--insecure-no-key): nothing it sends is signed or "
+        "vouched for, and it believes and obeys whatever arrives; anyone on the network can "
+        "steer the arm");
   } else {
     std::string path;
     try {

@@ -12,6 +12,8 @@
 ///     return sg::run_program(app, argc, argv, [&] {
 ///       const sg::Config config = sg::load_common(common);       // logging is set up
 ///       return sg::auth::with_lab_access(app.get_name(), key_options, [&](auto& lab) {
+///         sg::Bus bus(common.lcm_url);
+///         lab.guard(bus);                                          // every datum vouched for
 ///         lab.sign("ARM_COMMAND", command);                        // a sender
 ///         const std::string why = lab.refusal("ARM_COMMAND", command, sg::now_utime());
 ///         return 0;                                                // why: "" when accepted
@@ -20,11 +22,14 @@
 
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 
 #include "auth/command_auth.hpp"
+#include "auth/data_auth.hpp"
 #include "auth/lab_key.hpp"
+#include "common/bus.hpp"
 
 namespace sg::auth {
 
@@ -49,6 +54,15 @@ class LabAccess {
 
   bool secure() const { return key_.has_value(); }
   const std::optional<LabKey>& key() const { return key_; }
+  /// The name this program vouches as: its sender up to the '@' ("sg-grasp").
+  std::string identity() const { return sender_.substr(0, sender_.find('@')); }
+
+  /// Makes `bus` vouch for everything it sends and believe only what the lab allows on each
+  /// channel (a DataGuard with this program's credentials under the lab key, docs/security.md).
+  /// Nothing when insecure, and nothing on a `file://` bus: a recorded log is believed as it was
+  /// recorded (its counters are old). Returns the guard, or nullptr. Call before subscribing.
+  std::shared_ptr<DataGuard> guard(Bus& bus) const;
+
   /// The verifier (nullptr when insecure), for its counts.
   const CommandVerifier* verifier() const { return verifier_ ? &*verifier_ : nullptr; }
 
@@ -76,6 +90,13 @@ class LabAccess {
   std::optional<CommandSigner> signer_;
   std::optional<CommandVerifier> verifier_;
 };
+
+/// For a program that only looks (sg-viewer, the `status` commands): guards `bus` as `program`
+/// when the key `options` name (else the default one) can be loaded, else leaves it believing
+/// everything and says so in one warning. Never fails for want of a key; nothing on a file://
+/// bus. --insecure-no-key: no guard, no warning.
+std::shared_ptr<DataGuard> guard_if_key(Bus& bus, const std::string& program,
+                                        const KeyOptions& options);
 
 /// Loads the key that `options` name and runs `body` with the program's LabAccess, signing as
 /// `program`. With --insecure-no-key, first logs the warning (spdlog warn) "INSECURE: ...". A

@@ -19,6 +19,7 @@
 #include "common/log_format.hpp"
 #include "common/shutdown.hpp"
 #include "common/udpm_socket.hpp"
+#include "common/vouch_trailer.hpp"
 
 namespace sg {
 namespace {
@@ -117,10 +118,12 @@ class Bus::RawHandler {
     try {
       ++bus_.messages_received_;
       bus_.rates_.received(channel);
+      size_t payload = size;
+      if (!bus_.admit(channel, data, size, payload)) return;
       RawMessage raw;
       raw.info.channel = channel;
       raw.info.recv_utime = recv_utime;
-      raw.info.size = static_cast<int32_t>(size);
+      raw.info.size = static_cast<int32_t>(payload);
       raw.data = data;
       fn_(raw);
     } catch (const std::exception& e) {
@@ -163,8 +166,16 @@ Bus::~Bus() {
 }
 
 bool Bus::publish_raw(const std::string& channel, const void* data, int size) {
+  const auto* bytes = static_cast<const uint8_t*>(data);
+  buffer_.assign(bytes, bytes + std::max(size, 0));
+  return send_buffer(channel);
+}
+
+bool Bus::send_buffer(const std::string& channel) {
+  if (guard_) guard_->vouch(channel, buffer_);
+  const size_t size = buffer_.size();
   last_handed_utime_ = now_utime();
-  if (lcm_->publish(channel, data, static_cast<unsigned>(size)) == 0) {
+  if (lcm_->publish(channel, buffer_.data(), static_cast<unsigned>(size)) == 0) {
     rates_.sent(channel);
     return true;
   }
@@ -372,6 +383,33 @@ void Bus::report_decode_error(const ReceiveInfo& info, const std::string& why) {
                info.channel + ": dropped a " + std::to_string(info.size) + "-byte message: " + why);
 }
 
+bool Bus::admit(const std::string& channel, const uint8_t* data, size_t size, size_t& payload) {
+  if (!guard_) {
+    payload = vouched_payload_size(data, size);
+    return true;
+  }
+  const GuardResult r = guard_->check(channel, data, size, now_utime());
+  if (!r.accepted()) {
+    report_unvouched(channel, r);
+    return false;
+  }
+  payload = r.payload_size;
+  return true;
+}
+
+void Bus::report_unvouched(const std::string& channel, const GuardResult& result) {
+  UnvouchedKey key{channel.substr(0, 256), result.sender, result.verdict};
+  key.channel.erase(std::find(key.channel.begin(), key.channel.end(), '\0'), key.channel.end());
+  auto row = unvouched_.find(key);
+  if (row == unvouched_.end() && unvouched_.size() >= kUnvouchedRows)
+    row = unvouched_.try_emplace(UnvouchedKey{"(other)", "", GuardVerdict::kUnsigned}, 0).first;
+  else if (row == unvouched_.end())
+    row = unvouched_.emplace(std::move(key), 0).first;
+  ++row->second;
+  note_problem(++unvouched_inputs_, channel + ": refused, not vouched for (" +
+                                        to_string(result.verdict) + "): " + result.reason);
+}
+
 void Bus::report_handler_error(const std::string& channel, const std::string& what) {
   note_problem(++handler_errors_, channel + ": handler failed: " + what);
 }
@@ -436,6 +474,15 @@ stereograsp::process_status_t Bus::process_status(int64_t utime) {
       std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count());
   for (std::string& c : s.channel) c.erase(std::find(c.begin(), c.end(), '\0'), c.end());
   if (clock_sync_) clock_sync_->fill(s);
+  s.unvouched_inputs = static_cast<int64_t>(unvouched_inputs_);
+  for (const auto& [key, count] : unvouched_) {
+    s.unvouched_channel.push_back(key.channel);
+    s.unvouched_sender.push_back(key.sender);
+    s.unvouched_verdict.push_back(key.channel == "(other)" ? "" : to_string(key.verdict));
+    s.unvouched_count.push_back(static_cast<int64_t>(count));
+  }
+  s.num_unvouched = static_cast<int32_t>(s.unvouched_channel.size());
+  s.vouched_as = guard_ ? guard_->identity() : "";
   return s;
 }
 

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <lcm/lcm-cpp.hpp>
+#include <map>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -11,6 +12,7 @@
 
 #include "common/channel_rates.hpp"
 #include "common/clock_sync.hpp"
+#include "common/message_guard.hpp"
 #include "common/safe_decode.hpp"
 #include "stereograsp/process_status_t.hpp"
 
@@ -78,7 +80,16 @@ class Bus {
   /// The URL as given ("" for LCM's default).
   const std::string& url() const { return url_; }
 
-  /// Encodes and publishes; returns false (and logs, and counts) when LCM could not send.
+  /// From now on, vouches for everything this bus publishes with `guard` and hands its handlers
+  /// only what `guard` accepts, the trailer taken off (sg::MessageGuard). Refusals are counted
+  /// per channel, claimed sender and verdict (unvouched_inputs(), PROCESS_STATUS), logged like
+  /// decode errors, and never reach a handler. Without a guard the bus believes everything and
+  /// strips any well-formed trailer before decoding. Set it before subscribing or publishing.
+  void set_guard(std::shared_ptr<MessageGuard> guard) { guard_ = std::move(guard); }
+  const MessageGuard* guard() const { return guard_.get(); }
+
+  /// Encodes, vouches (with a guard) and publishes; returns false (and logs, and counts) when
+  /// LCM could not send.
   template <class Message>
   bool publish(const std::string& channel, const Message& message) {
     const int size = message.getEncodedSize();
@@ -87,10 +98,11 @@ class Bus {
       throw BusError("cannot encode " + std::string(Message::getTypeName()) + " for channel " +
                      channel);
     }
-    return publish_raw(channel, buffer_.data(), size);
+    return send_buffer(channel);
   }
 
-  /// Publishes bytes as they are (tools and tests).
+  /// Publishes bytes as they are, followed by the guard's trailer when the bus has a guard
+  /// (tools and tests).
   bool publish_raw(const std::string& channel, const void* data, int size);
 
   /// Calls `handler` with each message on channels matching `channel_regex` that decodes as
@@ -182,6 +194,18 @@ class Bus {
   uint64_t handler_errors() const { return handler_errors_; }
   uint64_t refused_inputs() const { return refused_inputs_; }
   uint64_t publish_errors() const { return publish_errors_; }
+  /// Messages the guard refused (none without a guard).
+  uint64_t unvouched_inputs() const { return unvouched_inputs_; }
+  /// Those refusals by (channel, claimed sender, verdict); at most kUnvouchedRows rows, the rest
+  /// under channel "(other)".
+  struct UnvouchedKey {
+    std::string channel;
+    std::string sender;
+    GuardVerdict verdict = GuardVerdict::kUnsigned;
+    auto operator<=>(const UnvouchedKey&) const = default;
+  };
+  static constexpr std::size_t kUnvouchedRows = 32;
+  const std::map<UnvouchedKey, uint64_t>& unvouched() const { return unvouched_; }
   /// When the last publish() handed its bytes to LCM (sg::now_utime(), read just before LCM's
   /// send): the moment a message leaves its publisher. On one host the send then delivers the
   /// datagram to the host's own subscribers before it returns, in the publisher's thread, and a
@@ -225,6 +249,12 @@ class Bus {
   }
   /// Reads what waits on the bus's own socket; true when a message was dispatched.
   bool drain_direct();
+  /// Puts the bytes in buffer_ on the bus, the guard's trailer appended when there is one.
+  bool send_buffer(const std::string& channel);
+  /// Whether a received message may reach a handler, and how many of its bytes are the LCM
+  /// encoding (the guard's verdict; without a guard, all but a well-formed trailer).
+  bool admit(const std::string& channel, const uint8_t* data, size_t size, size_t& payload);
+  void report_unvouched(const std::string& channel, const GuardResult& result);
   bool handle_lcm(int timeout_ms);
   void report_decode_error(const ReceiveInfo& info, const std::string& why);
   void report_handler_error(const std::string& channel, const std::string& what);
@@ -259,6 +289,9 @@ class Bus {
   uint64_t handler_errors_ = 0;
   uint64_t refused_inputs_ = 0;
   uint64_t publish_errors_ = 0;
+  uint64_t unvouched_inputs_ = 0;
+  std::map<UnvouchedKey, uint64_t> unvouched_;
+  std::shared_ptr<MessageGuard> guard_;
   int64_t last_handed_utime_ = 0;
   std::string last_problem_;
   std::string process_, host_;  // as announce()d; "" = no PROCESS_STATUS

@@ -101,6 +101,9 @@ void visit_fields(M& m, V& v) {
   SG_FIELD(messages_in); SG_FIELD(messages_out); SG_FIELD(rate_in_hz); SG_FIELD(rate_out_hz);
   SG_FIELD(num_peers); SG_FIELD(peer); SG_FIELD(peer_utime); SG_FIELD(peer_recv_utime);
   SG_FIELD(peer_offset_us); SG_FIELD(peer_offset_error_us);
+  SG_FIELD(unvouched_inputs); SG_FIELD(num_unvouched); SG_FIELD(unvouched_channel);
+  SG_FIELD(unvouched_sender); SG_FIELD(unvouched_verdict); SG_FIELD(unvouched_count);
+  SG_FIELD(vouched_as);
 }
 
 // clang-format on

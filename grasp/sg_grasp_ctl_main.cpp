@@ -149,6 +149,7 @@ int main(int argc, char** argv) {
     sg::Bus bus(common.lcm_url);
     if (wait && app.get_option("--timeout")->count() == 0) timeout = 60;
     if (*status) {
+      sg::auth::guard_if_key(bus, app.get_name(), key_options);
       const auto last =
           watch(bus, follow ? 1e9 : timeout, follow, [&](const Status&) { return !follow; });
       if (!last) throw std::runtime_error("no GRASP_STATUS: is sg-grasp running on this bus?");
@@ -162,6 +163,7 @@ int main(int argc, char** argv) {
                                       : Cmd::COMMAND_HOME;
     (void)home;
     return sg::auth::with_lab_access(app.get_name(), key_options, [&](sg::auth::LabAccess& lab) {
+      lab.guard(bus);
       return send(bus, lab, command, standoff, wait, timeout);
     });
   });

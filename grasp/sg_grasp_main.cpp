@@ -77,6 +77,7 @@ int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
         const sg::grasp::GraspSettings& settings, double status_rate, sg::auth::LabAccess& lab) {
   sg::install_shutdown_handlers();
   sg::Bus bus(url);
+  lab.guard(bus);  // believes OBJECT_TRAJECTORY, ARM_STATUS, ... only from their publishers
   bus.announce("sg-grasp");
   sg::grasp::GraspNode node(geometry, settings, sg::now_utime(), 1.0 / status_rate);
   if (lab.key()) node.require_signed_commands(*lab.key(), "GRASP_COMMAND");

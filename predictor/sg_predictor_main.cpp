@@ -17,6 +17,7 @@
 #include <chrono>
 #include <cstdio>
 
+#include "auth/lab_access.hpp"
 #include "common/bus.hpp"
 #include "common/clock.hpp"
 #include "common/message_types.hpp"
@@ -35,9 +36,11 @@ using sg::predictor::PredictorParams;
 /// Seconds between the status lines that report new refusals.
 constexpr double kStatusPeriod = 10.0;
 
-int run(const std::string& url, const sg::predictor::PredictorSettings& settings) {
+int run(const std::string& url, const sg::predictor::PredictorSettings& settings,
+        const sg::auth::LabAccess& lab) {
   sg::install_shutdown_handlers();
   sg::Bus bus(url);
+  lab.guard(bus);  // believes OBJECT_POSITION only from sg-vision
   bus.announce("sg-predictor");  // PROCESS_STATUS: the refusals counted with note_refused()
   sg::Clock& clock = sg::system_clock();
   sg::predictor::PredictorNode node(settings, clock);
@@ -104,6 +107,8 @@ int main(int argc, char** argv) {
                "sg-predictor"};
   sg::CommonOptions common;
   sg::add_common_options(app, common);
+  sg::auth::KeyOptions key_options;
+  sg::auth::add_key_options(app, key_options);
   const auto keys = sg::declared_keys(sg::predictor::read_predictor_settings);
   common.flags.add(app, "--model", "predictor.model", keys);
   common.flags.add(app, "--coefficients", "predictor.coefficients", keys);
@@ -125,6 +130,8 @@ int main(int argc, char** argv) {
     if (*train_cmd) return train(input, channel, settings.params, out);
     if (!settings.coefficients.empty())
       sg::predictor::read_coefficients(settings.coefficients, settings.params);
-    return run(common.lcm_url, settings);
+    return sg::auth::with_lab_access(app.get_name(), key_options, [&](auto& lab) {
+      return run(common.lcm_url, settings, lab);
+    });
   });
 }

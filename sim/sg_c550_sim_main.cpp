@@ -11,6 +11,7 @@
 
 #include <algorithm>
 
+#include "auth/lab_access.hpp"
 #include "arm_driver/kinematics.hpp"
 #include "common/bus.hpp"
 #include "common/program.hpp"
@@ -27,6 +28,8 @@ int main(int argc, char** argv) {
       "sg-c550-sim"};
   sg::CommonOptions common;
   sg::add_common_options(app, common);
+  sg::auth::KeyOptions key_options;
+  sg::auth::add_key_options(app, key_options);
   const auto keys = sg::declared_keys(sg::sim::read_c550_sim_settings);
   for (const char* key :
        {"slave", "delay_min", "delay_max", "speed", "seed", "link", "garble_rate", "drop_ack_rate",
@@ -45,9 +48,12 @@ int main(int argc, char** argv) {
     const sg::sim::C550SimSettings settings = sg::sim::read_c550_sim_settings(config);
     sg::install_shutdown_handlers();
     sg::sim::C550Controller controller(sg::arm::load_arm_geometry(config), settings.controller);
-    sg::Bus bus(common.lcm_url);
-    bus.announce("sg-c550-sim");
-    sg::sim::C550SimShell shell(settings, controller, bus);
-    return shell.run();
+    return sg::auth::with_lab_access(app.get_name(), key_options, [&](auto& lab) {
+      sg::Bus bus(common.lcm_url);
+      lab.guard(bus);  // believes GROUND_TRUTH only from sg-camera-sim
+      bus.announce("sg-c550-sim");
+      sg::sim::C550SimShell shell(settings, controller, bus);
+      return shell.run();
+    });
   });
 }

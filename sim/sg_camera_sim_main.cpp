@@ -17,6 +17,7 @@
 #include <opencv2/videoio.hpp>
 #include <thread>
 
+#include "auth/lab_access.hpp"
 #include "common/bus.hpp"
 #include "common/clock.hpp"
 #include "common/message_types.hpp"
@@ -125,8 +126,9 @@ int run_write(sg::sim::CameraSimulator& sim, const Options& o, int64_t frames) {
 }
 
 int run_bus(sg::sim::CameraSimulator& sim, const Options& o, int64_t frames, bool jpeg,
-            const std::string& url) {
+            const std::string& url, const sg::auth::LabAccess& lab) {
   sg::Bus bus(url);
+  lab.guard(bus);  // believes SIM_ARM_STATE only from sg-c550-sim
   bus.announce("sg-camera-sim");
   sg::sim::ArmState arm;
   bus.subscribe<stereograsp::sim_arm_state_t>(
@@ -182,6 +184,8 @@ int main(int argc, char** argv) {
                "sg-camera-sim"};
   sg::CommonOptions common;
   sg::add_common_options(app, common);
+  sg::auth::KeyOptions key_options;
+  sg::auth::add_key_options(app, key_options);
   Options o;
   const auto keys = sg::declared_keys(sg::sim::load_sim_params);
   common.flags.add(app, "--rate", "camera_sim.rate_hz", keys);
@@ -220,6 +224,8 @@ int main(int argc, char** argv) {
     if (!o.calibration_out.empty()) write_true_calibration(sim, o.calibration_out);
     if (!o.snapshot.empty()) return run_snapshot(sim, o);
     if (!o.write_dir.empty()) return run_write(sim, o, o.frames > 0 ? o.frames : 300);
-    return run_bus(sim, o, o.frames, jpeg, common.lcm_url);
+    return sg::auth::with_lab_access(app.get_name(), key_options, [&](auto& lab) {
+      return run_bus(sim, o, o.frames, jpeg, common.lcm_url, lab);
+    });
   });
 }

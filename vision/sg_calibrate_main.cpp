@@ -287,6 +287,7 @@ int run_robot(const std::string& url, const sg::vision::RobotCalibrationParams& 
   const double timeout_s = params.timeout;
   sg::install_shutdown_handlers();
   sg::Bus bus(url);
+  lab.guard(bus);
   // Sequence numbers from the clock, so they are newer than any the driver has seen.
   sg::vision::RobotCalibration cal(params, sg::now_utime());
   ArmWatch arm;

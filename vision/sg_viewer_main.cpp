@@ -12,6 +12,7 @@
 #include <opencv2/highgui.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "auth/lab_access.hpp"
 #include "common/bus.hpp"
 #include "common/program.hpp"
 #include "common/shutdown.hpp"
@@ -25,9 +26,10 @@ using stereograsp::image_t;
 
 /// Feeds the session from the bus until --frames are drawn or shutdown.
 int run(const std::string& url, sg::vision::ViewerSession& session, int64_t max_frames,
-        bool wait_for_blobs) {
+        bool wait_for_blobs, const sg::auth::KeyOptions& key_options) {
   sg::install_shutdown_handlers();
   sg::Bus bus(url);
+  sg::auth::guard_if_key(bus, "sg-viewer", key_options);  // it only looks: a key is optional
   bus.announce("sg-viewer");
   bus.subscribe<image_t>(
       "CAMERA_(LEFT|RIGHT)",
@@ -70,6 +72,8 @@ int main(int argc, char** argv) {
   CLI::App app{"The user interface: both cameras with what the vision stage found.", "sg-viewer"};
   sg::CommonOptions common;
   sg::add_common_options(app, common);
+  sg::auth::KeyOptions key_options;
+  sg::auth::add_key_options(app, key_options);
   sg::vision::ViewerSession::Options o;
   std::string calibration_path;
   int64_t max_frames = 0;
@@ -94,7 +98,7 @@ int main(int argc, char** argv) {
           "no display (DISPLAY is not set): give --record FILE to write a video");
     sg::vision::ViewerSession session(o, calibration ? &*calibration : nullptr,
                                       window_or_none(window));
-    run(common.lcm_url, session, max_frames, o.wait_for_blobs);
+    run(common.lcm_url, session, max_frames, o.wait_for_blobs, key_options);
     std::printf("drew %lld frames%s%s\n", static_cast<long long>(session.drawn()),
                 o.record.empty() ? "" : " into ", o.record.c_str());
     return 0;

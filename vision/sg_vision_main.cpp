@@ -16,6 +16,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
+#include "auth/lab_access.hpp"
 #include "common/bus.hpp"
 #include "common/program.hpp"
 #include "common/realtime.hpp"
@@ -108,6 +109,8 @@ int main(int argc, char** argv) {
   CLI::App app{"Finds the red ball in both cameras and places it in 3D.", "sg-vision"};
   sg::CommonOptions common;
   sg::add_common_options(app, common);
+  sg::auth::KeyOptions key_options;
+  sg::auth::add_key_options(app, key_options);
   const auto keys = sg::declared_keys(sg::vision::read_vision_settings);
   common.flags.add(app, "--decode", "vision.decode", keys);
   common.flags.add(app, "--camera-read", "vision.camera_read", keys);
@@ -151,11 +154,14 @@ int main(int argc, char** argv) {
     // Before the bus: LCM's receive thread inherits the policy.
     if (const std::string e = sg::enter_realtime(settings.realtime_priority); !e.empty())
       spdlog::warn("{}", e);
-    sg::Bus bus(common.lcm_url);
-    const cv::Size size = calibration
-                              ? cv::Size(calibration->left.width(), calibration->left.height())
-                              : cv::Size(o.width, o.height);
-    StereoPublisher vision(bus, settings, size, calibration, o.publish_images);
-    return o.source == "lcm" ? run_lcm(bus, vision, o, settings) : run_frames(vision, o);
+    return sg::auth::with_lab_access(app.get_name(), key_options, [&](auto& lab) {
+      sg::Bus bus(common.lcm_url);
+      lab.guard(bus);  // believes CAMERA_* only from the cameras
+      const cv::Size size = calibration
+                                ? cv::Size(calibration->left.width(), calibration->left.height())
+                                : cv::Size(o.width, o.height);
+      StereoPublisher vision(bus, settings, size, calibration, o.publish_images);
+      return o.source == "lcm" ? run_lcm(bus, vision, o, settings) : run_frames(vision, o);
+    });
   });
 }
