@@ -292,6 +292,16 @@ class Bus {
   uint64_t unvouched_inputs_ = 0;
   std::map<UnvouchedKey, uint64_t> unvouched_;
   std::shared_ptr<MessageGuard> guard_;
+  /// LCM hands one message to every subscription it matches, one after another within one
+  /// handle: the guard judges it once (a second check would call it a replay), and the others
+  /// get that verdict. dispatch_ counts the handles and direct messages.
+  uint64_t dispatch_ = 0;
+  struct Admitted {
+    uint64_t dispatch = ~uint64_t{0};
+    std::string channel;
+    bool accepted = false;
+    size_t payload = 0;
+  } admitted_;
   int64_t last_handed_utime_ = 0;
   std::string last_problem_;
   std::string process_, host_;  // as announce()d; "" = no PROCESS_STATUS

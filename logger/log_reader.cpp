@@ -2,12 +2,14 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <lcm/lcm-cpp.hpp>
 
 #include "common/log_format.hpp"
+#include "common/vouch_trailer.hpp"
 
 namespace sg::logger {
 namespace {
@@ -76,6 +78,19 @@ bool event_at(FILE* f, int64_t q, int64_t file_size, EventHeader& h) {
   return good;
 }
 
+}  // namespace
+
+namespace {
+/// A recorded message's vouching trailer (common/vouch_trailer.hpp) is not part of its type:
+/// readers get the LCM encoding, and who vouched for it beside.
+void take_off_trailer(LogRecord& out) {
+  out.recorded_size = out.size;
+  const TrailerParse p = parse_vouch_trailer(out.data, static_cast<size_t>(std::max(out.size, 0)));
+  out.vouched_by.clear();
+  if (p.kind != TrailerParse::kFound) return;
+  out.size = static_cast<int>(p.payload_size);
+  out.vouched_by = p.trailer.sender;
+}
 }  // namespace
 
 LogReader::LogReader(const std::string& path) : path_(path) {
@@ -155,6 +170,7 @@ bool LogReader::next(LogRecord& out) {
   out.data = static_cast<const uint8_t*>(event->data);
   out.size = event->datalen;
   out.offset = start;
+  take_off_trailer(out);
   ++events_;
   report_progress(false);
   return true;
@@ -189,6 +205,7 @@ bool LogReader::recover(LogRecord& out) {
     out.data = buffer_.data() + h.channel_length;
     out.size = static_cast<int>(h.data_length);
     out.offset = q;
+    take_off_trailer(out);
     end_of_last_ = q + kHeaderSize + h.channel_length + h.data_length;
     fseeko(f, end_of_last_, SEEK_SET);  // LCM goes on from here
     return true;

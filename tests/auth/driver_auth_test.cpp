@@ -1,7 +1,10 @@
-// sg-arm-driver (with a lab key) against sg-c550-sim on a real pseudo-terminal: an unsigned and
-// a forged ARM_COMMAND published on the raw bus are refused (ARM_STATUS names them
-// "unauthenticated: ..."), the emulator's arm does not move, and a signed command is executed;
-// its bytes sent again are refused as a replay.
+// sg-arm-driver (with a lab key) against sg-c550-sim on a real pseudo-terminal. Two layers: a
+// command nobody vouched for on the bus is refused before any handler (the driver's
+// PROCESS_STATUS counts it, ARM_STATUS never hears of it), and the same datagram vouched for
+// again is a replay there too; a command vouched for by sg-arm-ctl's credentials but unsigned or
+// forged is refused by the command check (ARM_STATUS names it "unauthenticated: ..."). The
+// emulator's arm does not move; a signed command is executed; its signature sent again is a
+// replay.
 
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -21,6 +24,7 @@
 #include "tests/integration/multicast_guard.hpp"
 #include "tests/support/arm_commands.hpp"
 #include "tests/support/subprocess.hpp"
+#include "tests/support/vouching.hpp"
 #include "tests/support/wait.hpp"
 
 namespace sg::test {
@@ -56,7 +60,15 @@ TEST(DriverAuth, RefusesUnsignedAndForgedExecutesSigned) {
   const std::string log = dir + "/commands.log";
   auth::write_new_key_file(key_path);
   const std::string url = test_url(kPort);
-  Bus bus(url);
+  Bus bus(url);  // the bench: vouches as sg-arm-ctl with the lab key
+  const auto bench = vouching_as("sg-arm-ctl", key_path);
+  bus.set_guard(bench);
+  Bus rogue(url);  // a host of the LAN without credentials
+  stereograsp::process_status_t driver_status{};
+  bus.subscribe<stereograsp::process_status_t>(
+      "PROCESS_STATUS", [&](const stereograsp::process_status_t& s, const ReceiveInfo&) {
+        if (s.process == "sg-arm-driver") driver_status = s;
+      });
   arm_status_t status{};
   int statuses = 0;
   bus.subscribe<arm_status_t>("ARM_STATUS", [&](const arm_status_t& s, const ReceiveInfo&) {
@@ -78,7 +90,29 @@ TEST(DriverAuth, RefusesUnsignedAndForgedExecutesSigned) {
       30s, "the driver connected and idle"));
   const sim_arm_state_t at_rest = truth;
 
-  // Unsigned: refused, named, nothing received.
+  // Not vouched for on the bus: refused before the driver's handler, counted on PROCESS_STATUS.
+  rogue.publish("ARM_COMMAND", move(9, "rogue"));
+  ASSERT_TRUE(eventually(bus, [&] {
+    return unvouched(driver_status, "ARM_COMMAND", "unsigned") >= 1;
+  }, 10s, "the unvouched command counted"));
+  EXPECT_EQ(status.last_rejected_sequence, -1);  // it never reached the driver
+  EXPECT_EQ(status.last_received_sequence, -1);
+
+  // The exact bytes of a vouched datagram, sent twice from the rogue host: the second is a
+  // replay on the bus (what lcm-logplayer does with a recorded session).
+  std::vector<uint8_t> vouched(static_cast<size_t>(move(8, "rogue").getEncodedSize()));
+  const arm_cmd_t eight = move(8, "rogue");
+  eight.encode(vouched.data(), 0, static_cast<int>(vouched.size()));
+  bench->inner().vouch("ARM_COMMAND", vouched);
+  rogue.publish_raw("ARM_COMMAND", vouched.data(), static_cast<int>(vouched.size()));
+  ASSERT_TRUE(eventually(bus, [&] { return status.last_rejected_sequence == 8; }, 10s,
+                         "the vouched but unsigned command refused by the command check"));
+  rogue.publish_raw("ARM_COMMAND", vouched.data(), static_cast<int>(vouched.size()));
+  ASSERT_TRUE(eventually(bus, [&] {
+    return unvouched(driver_status, "ARM_COMMAND", "replayed") >= 1;
+  }, 10s, "the datagram replayed refused on the bus"));
+
+  // Vouched for, but unsigned: refused by the command check, named, nothing received.
   bus.publish("ARM_COMMAND", move(10, "rogue"));
   ASSERT_TRUE(eventually(bus, [&] { return status.last_rejected_sequence == 10; }, 10s,
                          "the unsigned command refused"));

@@ -64,6 +64,12 @@ void fill_arrays(stereograsp::process_status_t& m, std::mt19937_64& rng) {
   m.peer_recv_utime.assign(p, static_cast<int64_t>(rng()));
   m.peer_offset_us.assign(p, static_cast<int64_t>(rng()));
   m.peer_offset_error_us.assign(p, -1);
+  m.num_unvouched = static_cast<int32_t>(rng() % 6);
+  const auto u = static_cast<size_t>(m.num_unvouched);
+  m.unvouched_channel.assign(u, "OBJECT_TRAJECTORY");
+  m.unvouched_sender.assign(u, "sg-intruder");
+  m.unvouched_verdict.assign(u, "not allowed");
+  m.unvouched_count.assign(u, static_cast<int64_t>(rng()));
 }
 void fill_arrays(image_t& m, std::mt19937_64& rng) {
   m.size = static_cast<int32_t>(rng() % 300);

@@ -23,6 +23,7 @@
 #include "tests/integration/multicast_guard.hpp"
 #include "tests/support/arm_commands.hpp"
 #include "tests/support/subprocess.hpp"
+#include "tests/support/vouching.hpp"
 #include "tests/support/wait.hpp"
 
 namespace sg::test {
@@ -89,6 +90,7 @@ class ArmRig {
  public:
   ArmRig(int port, std::vector<std::string> sim_flags)
       : dir_(make_temp_dir()), url_(test_url(port)), bus_(url_) {
+    bus_.set_guard(vouching_as("sg-arm-ctl"));  // the driver believes commands only from commanders
     bus_.subscribe<arm_status_t>("ARM_STATUS", [this](const arm_status_t& s, const ReceiveInfo&) {
       status_ = s;
       ++status_count_;
@@ -311,6 +313,7 @@ class OtherCommander {
   OtherCommander(const std::string& url, const std::string& name)
       : thread_([url, name](std::stop_token stop) {
           Bus bus(url);
+          bus.set_guard(vouching_as("sg-arm-ctl"));
           auth::CommandSigner signer(auth::LabKey::load(auth::default_key_path()), name);
           arm_cmd_t c = move_to(1, 0.40, 0.0, 0.35);
           while (!stop.stop_requested()) {

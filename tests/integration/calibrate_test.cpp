@@ -11,6 +11,7 @@
 
 #include "sim/stereo_rig.hpp"
 #include "tests/support/subprocess.hpp"
+#include "tests/support/vouching.hpp"
 #include "tests/support/workspace.hpp"
 #include "vision/calibration_file.hpp"
 #include "vision/registration.hpp"
@@ -169,7 +170,10 @@ TEST(Calibrate, RobotGuidedOverLcm) {
   ASSERT_TRUE(multicast_available(kPort));
   const std::string dir = make_temp_dir();
   const auto rig = sim::make_rig({});
-  Bus bus(test_url(kPort));
+  Bus bus(test_url(kPort));  // the arm's driver: ARM_STATUS, and the commands it hears
+  bus.set_guard(vouching_as("sg-arm-driver"));
+  Bus eyes(test_url(kPort));  // sg-vision: the blobs of the carried ball
+  eyes.set_guard(vouching_as("sg-vision"));
   Eigen::Vector3d ball = Eigen::Vector3d::Zero();
   int64_t executed = -1, commands = 0, releases = 0;
   bool moving = false;
@@ -212,7 +216,7 @@ TEST(Calibrate, RobotGuidedOverLcm) {
       b.centroid[0] = px.x() + noise(rng), b.centroid[1] = px.y() + noise(rng);
       b.centre[0] = b.centroid[0], b.centre[1] = b.centroid[1];  // a whole disc: no fit
       b.fit_support = std::nan("");
-      bus.publish(c == 0 ? "BLOB_LEFT" : "BLOB_RIGHT", b);
+      eyes.publish(c == 0 ? "BLOB_LEFT" : "BLOB_RIGHT", b);
     }
   }
   const ProcessResult r = calibrate.wait(5s);

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -13,6 +14,7 @@
 #include "common/message_types.hpp"
 #include "tests/integration/multicast_guard.hpp"
 #include "tests/support/subprocess.hpp"
+#include "tests/support/vouching.hpp"
 #include "tests/support/wait.hpp"
 #include "vision/calibration_file.hpp"
 
@@ -106,17 +108,15 @@ TEST(CameraSim, DropsFramesItCannotRenderInTime) {
   EXPECT_GT(left.front().first.utime, started);
 }
 
-// The gripper's state on SIM_ARM_STATE reaches the simulator: a ball held by the gripper is where
-// the tool is, in GROUND_TRUTH.
-TEST(CameraSim, FollowsSimArmStateFromTheBus) {
-  constexpr int kPort = 7908;
-  ASSERT_TRUE(multicast_available(kPort));
-  Bus bus(test_url(kPort));
+/// sg-camera-sim at 10 Hz for 40 frames while `bus` publishes a simulated arm holding the ball at
+/// (0.40, 0.10, 0.30); the GROUND_TRUTH it published.
+std::vector<stereograsp::point3_t> truth_while_holding(Bus& bus, int port) {
   std::vector<stereograsp::point3_t> truth;
-  bus.subscribe<stereograsp::point3_t>("GROUND_TRUTH",
-                                       [&](const auto& m, const auto&) { truth.push_back(m); });
-  Child sim(
-      {program("sg-camera-sim"), "--rate", "10", "--frames", "40", "--lcm-url", test_url(kPort)});
+  Bus watcher(test_url(port));
+  watcher.subscribe<stereograsp::point3_t>("GROUND_TRUTH",
+                                           [&](const auto& m, const auto&) { truth.push_back(m); });
+  Child sim({program("sg-camera-sim"), "--rate", "10", "--frames", "40", "--lcm-url",
+             test_url(port)});
   stereograsp::sim_arm_state_t arm{};
   arm.tool_position[0] = 0.40, arm.tool_position[1] = 0.10, arm.tool_position[2] = 0.30;
   arm.tool_orientation[1] = M_PI;
@@ -125,14 +125,43 @@ TEST(CameraSim, FollowsSimArmStateFromTheBus) {
   const auto deadline = std::chrono::steady_clock::now() + 30s;
   while (truth.size() < 40 && std::chrono::steady_clock::now() < deadline) {
     bus.publish("SIM_ARM_STATE", arm);
-    bus.handle(50ms);
+    watcher.handle(50ms);
   }
   EXPECT_EQ(sim.wait(30s).exit_code, 0);
+  return truth;
+}
+
+// The gripper's state on SIM_ARM_STATE, vouched for by sg-c550-sim, reaches the simulator: a
+// ball held by the gripper is where the tool is, in GROUND_TRUTH.
+TEST(CameraSim, FollowsSimArmStateFromTheBus) {
+  constexpr int kPort = 7908;
+  ASSERT_TRUE(multicast_available(kPort));
+  Bus c550(test_url(kPort));
+  c550.set_guard(vouching_as("sg-c550-sim"));
+  const std::vector<stereograsp::point3_t> truth = truth_while_holding(c550, kPort);
   ASSERT_GE(truth.size(), 30u);
   const stereograsp::point3_t& last = truth.back();
   EXPECT_DOUBLE_EQ(last.position[0], 0.40);
   EXPECT_DOUBLE_EQ(last.position[1], 0.10);
   EXPECT_DOUBLE_EQ(last.position[2], 0.30);
+}
+
+// A SIM_ARM_STATE nobody the lab allows vouched for (a host without credentials, or one holding
+// only sg-vision's) cannot carry the simulated ball away: it stays on its path, never at the tool.
+TEST(CameraSim, IgnoresSimArmStateNobodyVouchedFor) {
+  constexpr int kPort = 7909;
+  ASSERT_TRUE(multicast_available(kPort));
+  for (const bool as_vision : {false, true}) {
+    Bus rogue(test_url(kPort));
+    if (as_vision) rogue.set_guard(vouching_as("sg-vision"));
+    const std::vector<stereograsp::point3_t> truth = truth_while_holding(rogue, kPort);
+    ASSERT_GE(truth.size(), 30u) << as_vision;
+    for (const auto& p : truth) {
+      ASSERT_GT(std::hypot(p.position[0] - 0.40, p.position[1] - 0.10, p.position[2] - 0.30),
+                0.05)
+          << "the forged arm state moved the ball (as sg-vision: " << as_vision << ")";
+    }
+  }
 }
 
 // --write gives two videos OpenCV reads back frame by frame, a CSV row per frame, and the true

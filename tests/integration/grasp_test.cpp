@@ -21,6 +21,7 @@
 #include "tests/integration/multicast_guard.hpp"
 #include "tests/support/paper_circle.hpp"
 #include "tests/support/subprocess.hpp"
+#include "tests/support/vouching.hpp"
 #include "tests/support/wait.hpp"
 
 namespace sg::test {
@@ -215,6 +216,7 @@ TEST(GraspLoop, RestartedAfterKillNineSendsNothingUntilCommanded) {
   const std::string url = test_url(7925);
   const std::string dir = make_temp_dir();
   Bus bus(url);
+  bus.set_guard(vouching_as("sg-predictor"));  // sg-grasp believes forecasts only from it
   Watch watch(bus);
   CommandWatch sent(bus);
   std::optional<stereograsp::grasp_status_t> status;

@@ -14,6 +14,7 @@
 #include "common/message_types.hpp"
 #include "tests/integration/multicast_guard.hpp"
 #include "tests/support/subprocess.hpp"
+#include "tests/support/vouching.hpp"
 #include "tests/support/wait.hpp"
 #include "vision/image_message.hpp"
 
@@ -35,6 +36,7 @@ TEST(Vision, PositionsFromSimulatedCamerasMatchTheTruth) {
                 .exit_code,
             0);
   Bus bus(url);
+  bus.set_guard(vouching_as("sg-camera-sim"));  // sg-vision believes images only from the cameras
   std::map<int64_t, stereograsp::point3_t> truth, measured;
   int blobs = 0;
   bus.subscribe<stereograsp::point3_t>("GROUND_TRUTH",

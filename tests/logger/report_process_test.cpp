@@ -19,6 +19,7 @@
 #include "common/message_types.hpp"
 #include "tests/integration/multicast_guard.hpp"
 #include "tests/support/subprocess.hpp"
+#include "tests/support/vouching.hpp"
 #include "tests/support/wait.hpp"
 
 namespace sg::test {
@@ -240,6 +241,7 @@ TEST(ReportLive, RecordedSessionFromTheRealPredictor) {
       30s, "sg-predictor and lcm-logger to join the bus"));
 
   Bus bus(test_url(7922));
+  bus.set_guard(vouching_as("sg-vision"));  // the predictor believes positions only from vision
   int64_t newest_source = 0;  // the newest forecast's measurement time
   int positions_heard = 0, forecasts_heard = 0;
   bus.subscribe<stereograsp::trajectory_t>(

@@ -109,6 +109,12 @@ inline void make_consistent(stereograsp::process_status_t& m) {
   m.peer_recv_utime.resize(peers, std::numeric_limits<int64_t>::min());
   m.peer_offset_us.resize(peers, 0);
   m.peer_offset_error_us.resize(peers, -1);
+  m.num_unvouched = std::clamp<int32_t>(m.num_unvouched, 0, 64);
+  const auto refusals = static_cast<size_t>(m.num_unvouched);
+  m.unvouched_channel.resize(refusals, "OBJECT_TRAJECTORY");
+  m.unvouched_sender.resize(refusals, "sg-predictor");
+  m.unvouched_verdict.resize(refusals, "bad tag");
+  m.unvouched_count.resize(refusals, 3);
 }
 inline void make_consistent(stereograsp::blob_t& m) { m.found = m.found != 0; }
 inline void make_consistent(stereograsp::point3_t& m) { m.visible = m.visible != 0; }
