@@ -8,7 +8,7 @@
 namespace sg::auth {
 namespace {
 
-constexpr char kDigestDomain[] = "sg-vouch-v1";
+constexpr char kKeyDomain[] = "sg-otk-v1";
 constexpr char kPairDomain[] = "sg-pair-v1";
 
 bool contains(const std::vector<std::string>& names, const std::string& name) {
@@ -118,26 +118,29 @@ Credentials credentials_from_lab_key(const LabKey& lab, const std::string& ident
   return c;
 }
 
-std::array<uint8_t, 32> vouch_digest(const std::string& channel, const VouchTrailer& trailer,
-                                     const uint8_t* payload, std::size_t size) {
+std::array<uint8_t, 32> one_time_key(const PairKey& key, const std::string& channel,
+                                     const VouchTrailer& trailer) {
   crypto_generichash_state state;
-  crypto_generichash_init(&state, nullptr, 0, 32);
-  crypto_generichash_update(&state, reinterpret_cast<const unsigned char*>(kDigestDomain),
-                            sizeof kDigestDomain - 1);
+  crypto_generichash_init(&state, key.bytes().data(), key.bytes().size(), 32);
+  crypto_generichash_update(&state, reinterpret_cast<const unsigned char*>(kKeyDomain),
+                            sizeof kKeyDomain - 1);
   hash_name(state, channel);
   hash_name(state, trailer.sender);
   hash_be(state, trailer.instance, 4);
   hash_be(state, static_cast<uint64_t>(trailer.counter), 8);
-  crypto_generichash_update(&state, payload, size);
-  std::array<uint8_t, 32> h{};
-  crypto_generichash_final(&state, h.data(), h.size());
-  return h;
+  std::array<uint8_t, 32> k{};
+  crypto_generichash_final(&state, k.data(), k.size());
+  return k;
 }
 
-std::array<uint8_t, kVouchTagSize> vouch_tag(const PairKey& key, const std::array<uint8_t, 32>& h) {
+std::array<uint8_t, kVouchTagSize> vouch_tag(const PairKey& key, const std::string& channel,
+                                             const VouchTrailer& trailer, const uint8_t* payload,
+                                             std::size_t size) {
+  static_assert(kVouchTagSize == crypto_onetimeauth_BYTES);
+  std::array<uint8_t, 32> k = one_time_key(key, channel, trailer);
   std::array<uint8_t, kVouchTagSize> tag{};
-  crypto_generichash(tag.data(), tag.size(), h.data(), h.size(), key.bytes().data(),
-                     key.bytes().size());
+  crypto_onetimeauth(tag.data(), payload, size, k.data());
+  sodium_memzero(k.data(), k.size());
   return tag;
 }
 
@@ -172,13 +175,11 @@ void DataGuard::vouch(const std::string& channel, std::vector<uint8_t>& message)
   last_counter_ = std::max(last_counter_ + 1, clock_.utime());
   t.counter = last_counter_;
   const std::vector<std::size_t>& readers = readers_of(channel);
-  if (!readers.empty()) {
-    const std::array<uint8_t, 32> h = vouch_digest(channel, t, message.data(), message.size());
-    t.tags.reserve(readers.size());
-    for (const std::size_t i : readers) {
-      const Peer& reader = credentials_.send[i];
-      t.tags.push_back(VouchTag{reader.name, vouch_tag(reader.key, h)});
-    }
+  t.tags.reserve(readers.size());
+  for (const std::size_t i : readers) {
+    const Peer& reader = credentials_.send[i];
+    t.tags.push_back(
+        VouchTag{reader.name, vouch_tag(reader.key, channel, t, message.data(), message.size())});
   }
   append_vouch_trailer(message, t);
 }
@@ -211,9 +212,10 @@ GuardResult DataGuard::check(const std::string& channel, const uint8_t* data, st
     return judge(GuardVerdict::kNoTag, t.sender,
                  "'" + t.sender + "' vouched for " + std::to_string(t.tags.size()) +
                      " readers, not for " + credentials_.identity);
-  const auto expected = vouch_tag(sender->key, vouch_digest(channel, t, data, p.payload_size));
-  if (sodium_memcmp(expected.data(), mine->tag.data(), kVouchTagSize) != 0)
-    return judge(GuardVerdict::kBadTag, t.sender, "bad tag from '" + t.sender + "'");
+  std::array<uint8_t, 32> k = one_time_key(sender->key, channel, t);
+  const bool good = crypto_onetimeauth_verify(mine->tag.data(), data, p.payload_size, k.data()) == 0;
+  sodium_memzero(k.data(), k.size());
+  if (!good) return judge(GuardVerdict::kBadTag, t.sender, "bad tag from '" + t.sender + "'");
   GuardResult r = check_counter(channel, t, now_utime);
   if (r.accepted()) r.payload_size = p.payload_size;
   return r;

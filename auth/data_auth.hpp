@@ -5,15 +5,21 @@
 /// publishers the lab allows on that channel. The proof is one 16-byte tag per reader in the
 /// message's trailer (common/vouch_trailer.hpp):
 ///
-///     h   = BLAKE2b-256("sg-vouch-v1" || u8 |channel| || channel || u8 |sender| || sender
-///                       || be32 instance || be64 counter || LCM encoding)
-///     tag = BLAKE2b-128(key = K(sender -> reader), h)
+///     k   = BLAKE2b-256(key = K(sender -> reader), "sg-otk-v1" || u8 |channel| || channel
+///                       || u8 |sender| || sender || be32 instance || be64 counter)
+///     tag = Poly1305(k, LCM encoding)
+///
+/// k is a one-time key: the counter never repeats within an instance (below), so no two messages
+/// share one, which is what Poly1305 (the MAC of crypto_secretbox) asks. It binds the channel,
+/// sender, run and counter; the tag binds every byte of the message. Poly1305 reads 44 KB in
+/// 11 us here where BLAKE2b takes 45 us: a camera image costs its reader a quarter as much.
 ///
 /// K(sender -> reader) is a key only that pair holds: BLAKE2b-256 keyed with the lab key over
 /// "sg-pair-v1" || u8 |sender| || sender || u8 |reader| || reader. So a reader cannot forge what
 /// a sender says to another reader, and a host that holds only some processes' credentials can
 /// speak as those processes and no others: what a public-key signature gives, at the cost of a
-/// keyed hash per reader (Ed25519 costs 35 us to sign and 50-70 us to verify here; a tag, 0.5 us).
+/// MAC per reader (Ed25519 costs 35 us to sign and 50-70 us to verify here; a tag of a 1 KB
+/// message, about 1 us).
 /// The counter is max(last + 1, the sender's clock in us): a reader refuses a counter not newer
 /// than the last it accepted from that instance on that channel (a replay), or further than
 /// max_age behind or max_ahead ahead of its own clock (a log played onto a live bus, a clock off
@@ -153,10 +159,12 @@ class DataGuard final : public MessageGuard {
   uint64_t accepted_ = 0;
 };
 
-/// h for these bytes (the tag's message), for tests and the fuzzer.
-std::array<uint8_t, 32> vouch_digest(const std::string& channel, const VouchTrailer& trailer,
-                                     const uint8_t* payload, std::size_t size);
-/// The tag `key` gives digest `h`.
-std::array<uint8_t, kVouchTagSize> vouch_tag(const PairKey& key, const std::array<uint8_t, 32>& h);
+/// The one-time key k of a message (above), for tests and the fuzzer.
+std::array<uint8_t, 32> one_time_key(const PairKey& key, const std::string& channel,
+                                     const VouchTrailer& trailer);
+/// The tag a reader holding `key` expects on `size` bytes at `payload` with `trailer`.
+std::array<uint8_t, kVouchTagSize> vouch_tag(const PairKey& key, const std::string& channel,
+                                             const VouchTrailer& trailer, const uint8_t* payload,
+                                             std::size_t size);
 
 }  // namespace sg::auth

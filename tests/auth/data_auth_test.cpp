@@ -132,8 +132,7 @@ TEST(DataAuth, AReaderCannotForgeForAnotherReader) {
   ASSERT_NE(from_predictor, nullptr);
   std::vector<uint8_t> m = payload();
   VouchTrailer t{"sg-predictor", 99, kT0, {{"sg-grasp", {}}}};
-  t.tags[0].tag = vouch_tag(from_predictor->key, vouch_digest("OBJECT_TRAJECTORY", t, m.data(),
-                                                              m.size()));
+  t.tags[0].tag = vouch_tag(from_predictor->key, "OBJECT_TRAJECTORY", t, m.data(), m.size());
   append_vouch_trailer(m, t);
   EXPECT_EQ(verdict(lab.grasp, "OBJECT_TRAJECTORY", m), GuardVerdict::kBadTag);
 }
@@ -222,8 +221,8 @@ TEST(DataAuth, StreamTableIsBounded) {
   EXPECT_EQ(grasp.streams(), 8u);
 }
 
-// The pair key and the digest, computed independently with libsodium's one-shot BLAKE2b over the
-// bytes the header documents.
+// The pair key, the one-time key and the tag, computed independently with libsodium's one-shot
+// BLAKE2b and Poly1305 over the bytes the header documents.
 TEST(DataAuth, KeysAndTagsAreTheDocumentedBlake2b) {
   const LabKey lab = key_of(9);
   std::vector<uint8_t> label = {'s', 'g', '-', 'p', 'a', 'i', 'r', '-', 'v', '1', 1, 'a', 2, 'b', 'c'};
@@ -232,14 +231,18 @@ TEST(DataAuth, KeysAndTagsAreTheDocumentedBlake2b) {
   EXPECT_EQ(pair_key(lab, "a", "bc").bytes(), expected);
   EXPECT_NE(pair_key(lab, "bc", "a").bytes(), expected);
 
+  const PairKey pair = pair_key(lab, "a", "bc");
   const VouchTrailer t{"s", 0x01020304, 0x05, {}};
-  const std::vector<uint8_t> body = {7, 8};
-  std::vector<uint8_t> h_input = {'s', 'g', '-', 'v', 'o', 'u', 'c', 'h', '-', 'v', '1',
-                                  2,   'C', 'H', 1,   's', 1,   2,   3,   4,   0,   0,
-                                  0,   0,   0,   0,   0,   5,   7,   8};
-  std::array<uint8_t, 32> h{};
-  crypto_generichash(h.data(), 32, h_input.data(), h_input.size(), nullptr, 0);
-  EXPECT_EQ(vouch_digest("CH", t, body.data(), body.size()), h);
+  const std::vector<uint8_t> k_input = {'s', 'g', '-', 'o', 't', 'k', '-', 'v', '1', 2, 'C', 'H',
+                                        1,   's', 1,   2,   3,   4,   0,   0,   0,   0,   0,   0,
+                                        0,   5};
+  std::array<uint8_t, 32> k{};
+  crypto_generichash(k.data(), 32, k_input.data(), k_input.size(), pair.bytes().data(), 32);
+  EXPECT_EQ(one_time_key(pair, "CH", t), k);
+  const std::vector<uint8_t> body = {7, 8, 9};
+  std::array<uint8_t, 16> tag{};
+  crypto_onetimeauth(tag.data(), body.data(), body.size(), k.data());
+  EXPECT_EQ(vouch_tag(pair, "CH", t, body.data(), body.size()), tag);
 }
 
 // The default rights: each reader of a channel holds a receive peer for each of its publishers,
