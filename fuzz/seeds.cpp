@@ -21,6 +21,7 @@
 #include "arm_driver/rapl.hpp"
 #include "common/bus_check.hpp"
 #include "fuzz/signed_commands.hpp"
+#include "fuzz/vouched_messages.hpp"
 #include "predictor/offline_training.hpp"
 #include "sim/c550_controller.hpp"
 #include "sim/c550_emulator.hpp"
@@ -201,6 +202,30 @@ void signed_commands(const fs::path& out) {
   save(out / "mac_check/two_arm_in_order", records({good[0], good[1], good[2]}));
 }
 
+/// vouch_check: two forecasts and an ARM_STATUS vouched for, each alone and in order; a forecast
+/// vouched for by a process not allowed on its channel and under another key; a replay; a stale
+/// forecast (the reader's clock 40 s on); unvouched bytes.
+void vouched_messages(const fs::path& out) {
+  namespace fz = sg::fuzz;
+  const std::vector<fz::VouchedMessage> good = fz::vouched_messages();
+  const std::vector<fz::VouchedMessage> bad = fz::not_allowed_and_wrong_key();
+  const auto records = [](std::vector<fz::VouchedMessage> messages, int clock_step = 32) {
+    Bytes input;
+    for (const fz::VouchedMessage& m : messages) fz::append_vouch_record(input, m, clock_step);
+    return input;
+  };
+  fz::VouchedMessage plain = good[0];
+  plain.bytes.resize(sg::vouched_payload_size(plain.bytes.data(), plain.bytes.size()));
+  save(out / "vouch_check/forecast", records({good[0]}));
+  save(out / "vouch_check/arm_status", records({good[2]}));
+  save(out / "vouch_check/in_order", records({good[0], good[1], good[2]}));
+  save(out / "vouch_check/not_allowed", records({bad[0]}));
+  save(out / "vouch_check/other_key", records({bad[1]}));
+  save(out / "vouch_check/replayed", records({good[0], good[0]}));
+  save(out / "vouch_check/stale", records({good[0]}, 52));
+  save(out / "vouch_check/unvouched", records({plain}));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -214,5 +239,6 @@ int main(int argc, char** argv) {
   logs(out);
   coefficients(out);
   signed_commands(out);
+  vouched_messages(out);
   return 0;
 }

@@ -13,6 +13,7 @@
 #include <signal.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <deque>
 #include <filesystem>
@@ -71,32 +72,29 @@ struct Truth {
   std::map<std::string, stereograsp::process_status_t> status;
 };
 
-/// The paper's circle 16 steps ahead from `now`, shifted kSide along Y: a forecast as sg-predictor
-/// would publish it, of a ball that is not there.
-stereograsp::trajectory_t forged_forecast(int64_t now) {
+/// A forecast as sg-predictor would publish it at `now`, of a ball kSide beside the real one
+/// (`real`, GROUND_TRUTH), still, sure of itself: a ball that is not there.
+stereograsp::trajectory_t forged_forecast(int64_t now, const stereograsp::point3_t& real) {
   stereograsp::trajectory_t m{};
   m.utime = now - 50'000;
   m.source_utime = m.utime;
   m.period_us = 250'000;
   m.start_utime = now + m.period_us;
   m.num_points = 16;
-  for (int i = 0; i < 16; ++i) {
-    const double t = 1e-6 * static_cast<double>(m.start_utime + i * m.period_us);
-    const double a = 2 * M_PI * t / 60.0;
-    m.position.push_back({0.45 + 0.15 * std::cos(a), 0.15 * std::sin(a) + kSide, 0.10});
-    m.position_sigma.push_back({0.0005, 0.0005, 0.0005});
-  }
+  m.position.assign(16, {real.position[0], real.position[1] + kSide, real.position[2]});
+  m.position_sigma.assign(16, {0.0005, 0.0005, 0.0005});
   m.status = stereograsp::trajectory_t::STATUS_TRACKING;
   return m;
 }
 
 /// An intruder: its own bus (vouching as `identity`, or with no credentials when ""), publishing
-/// forgeries at 20 Hz from forge(); with images, it also replays the camera frames it heard
-/// 3 s earlier as new ones (the ball where it was then).
+/// forgeries at 20 Hz from forge(): forecasts and positions kSide beside the real ball, and with
+/// `all`, blobs and an ARM_STATUS of an idle arm that executed everything, and the camera frames
+/// it heard 3 s earlier replayed as new ones (the ball where it was then).
 class Intruder {
  public:
-  Intruder(const std::string& url, const std::string& identity, bool images)
-      : bus_(url), images_(images) {
+  Intruder(const std::string& url, const std::string& identity, bool all)
+      : bus_(url), images_(all && identity.empty()), all_(all) {
     if (!identity.empty()) bus_.set_guard(vouching_as(identity));
     if (images_) {
       for (const char* c : {"CAMERA_LEFT", "CAMERA_RIGHT"}) {
@@ -112,12 +110,14 @@ class Intruder {
     const int64_t now = now_utime();
     if (now - last_ < 50'000) return;
     last_ = now;
-    bus_.publish("OBJECT_TRAJECTORY", forged_forecast(now));
+    bus_.publish("OBJECT_TRAJECTORY", forged_forecast(now, real_ball));
     stereograsp::point3_t p = real_ball;
     p.utime = now - 50'000;
     p.position[1] += kSide;
     p.visible = 1;
     bus_.publish("OBJECT_POSITION", p);
+    ++rounds_;
+    if (!all_) return;
     stereograsp::arm_status_t s{};
     s.utime = now;
     s.state = stereograsp::arm_status_t::STATE_IDLE;
@@ -137,14 +137,13 @@ class Intruder {
       bus_.publish(channel, image);
       ++images_sent_;
     }
-    ++rounds_;
   }
   int rounds() const { return rounds_; }
   int images_sent() const { return images_sent_; }
 
  private:
   Bus bus_;
-  bool images_;
+  bool images_, all_;
   std::deque<std::pair<std::string, stereograsp::image_t>> heard_;
   int64_t last_ = 0;
   int rounds_ = 0;
@@ -246,8 +245,11 @@ TEST(ForgedData, TheArmFollowsOnlyWhatTheLabVouchedFor) {
   ASSERT_TRUE(start_tracking(bus, truth, url, {}));
   const auto [before, before_forgery] = under_attack(bus, truth, {}, 10);
 
-  Intruder stranger(url, "", true), cameras_host(url, "sg-camera-sim", false);
+  Intruder stranger(url, "", true), cameras_host(url, "sg-camera-sim", true);
   const auto [during, during_forgery] = under_attack(bus, truth, {&stranger, &cameras_host}, 15);
+  std::printf("tool to the real ball (median, horizontal): %.1f mm before the forgery, %.1f mm "
+              "during it; to the made-up ball %.1f mm during it\n",
+              before * 1e3, during * 1e3, during_forgery * 1e3);
   EXPECT_GT(stranger.rounds(), 200);
   EXPECT_GT(stranger.images_sent(), 20);
   EXPECT_LT(during, 0.03) << "before the forgery " << before;
@@ -291,6 +293,8 @@ TEST(ForgedData, WithoutVouchingTheArmFollowsTheForgery) {
   Intruder stranger(url, "", false);
   under_attack(bus, truth, {&stranger}, 5);  // the arm's way over
   const auto [during, during_forgery] = under_attack(bus, truth, {&stranger}, 10);
+  std::printf("insecure: tool to the real ball %.1f mm, to the made-up ball %.1f mm (medians)\n",
+              during * 1e3, during_forgery * 1e3);
   EXPECT_GT(during, 0.10);
   EXPECT_LT(during_forgery, 0.05);
 }
