@@ -97,6 +97,10 @@ PairKey pair_key(const LabKey& lab, const std::string& sender, const std::string
   return key;
 }
 
+bool is_command_channel(const std::string& channel) {
+  return channel == "ARM_COMMAND" || channel == "GRASP_COMMAND";
+}
+
 Credentials credentials_from_lab_key(const LabKey& lab, const std::string& identity,
                                      const ChannelRights& rights) {
   if (!valid_vouch_name(identity))
@@ -114,6 +118,9 @@ Credentials credentials_from_lab_key(const LabKey& lab, const std::string& ident
         peer_named(c.receive, publisher, pair_key(lab, publisher, identity))
             .channels.push_back(right.channel);
     }
+    const bool party = contains(right.publishers, identity) || contains(right.readers, identity);
+    if (party && is_command_channel(right.channel) && !c.command_key)
+      c.command_key = command_key(lab);
   }
   return c;
 }

@@ -37,7 +37,7 @@
 
 #include <array>
 #include <cstdint>
-#include <map>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -100,7 +100,13 @@ struct Credentials {
   std::string identity;
   std::vector<Peer> send;
   std::vector<Peer> receive;
+  /// The key that signs and checks commands (auth::command_key), for a process that sends or
+  /// obeys them; none for the others.
+  std::optional<LabKey> command_key;
 };
+
+/// The channels that carry commands: whoever publishes or reads them holds the command key.
+bool is_command_channel(const std::string& channel);
 
 /// `identity`'s credentials under the lab key and `rights`: a send peer per reader of each channel
 /// it may publish on, a receive peer per publisher of each channel it reads. Throws

@@ -21,21 +21,27 @@ void add_key_options(CLI::App& app, KeyOptions& options) {
   key->excludes(insecure);
 }
 
-LabAccess::LabAccess(std::optional<LabKey> key, std::string sender, VerifierSettings settings)
-    : key_(std::move(key)), sender_(std::move(sender)) {
-  if (key_) {
-    signer_.emplace(*key_, sender_);
-    verifier_.emplace(*key_, settings);
+LabAccess::LabAccess(std::optional<Credentials> credentials, std::string sender,
+                     VerifierSettings settings)
+    : credentials_(std::move(credentials)), sender_(std::move(sender)) {
+  if (credentials_ && credentials_->command_key) {
+    signer_.emplace(*credentials_->command_key, sender_);
+    verifier_.emplace(*credentials_->command_key, settings);
   }
 }
 
+const std::optional<LabKey>& LabAccess::command_key() const {
+  static const std::optional<LabKey> none;
+  return credentials_ ? credentials_->command_key : none;
+}
+
 std::shared_ptr<DataGuard> LabAccess::guard(Bus& bus) const {
-  if (!key_) return nullptr;
+  if (!credentials_) return nullptr;
   if (bus.url().rfind("file://", 0) == 0) {
     spdlog::info("reading a recorded log ({}): its messages are believed as recorded", bus.url());
     return nullptr;
   }
-  auto guard = std::make_shared<DataGuard>(credentials_from_lab_key(*key_, identity()));
+  auto guard = std::make_shared<DataGuard>(*credentials_);
   bus.set_guard(guard);
   return guard;
 }
@@ -45,7 +51,7 @@ std::shared_ptr<DataGuard> guard_if_key(Bus& bus, const std::string& program,
   if (options.insecure) return nullptr;
   try {
     const std::string path = options.path.empty() ? default_key_path() : options.path;
-    return LabAccess(LabKey::load(path), instance_name(program)).guard(bus);
+    return LabAccess(load_key_file(path, program), instance_name(program)).guard(bus);
   } catch (const LabKeyError& e) {
     spdlog::warn("{}; showing what arrives without checking who sent it", e.what());
     return nullptr;
@@ -54,7 +60,7 @@ std::shared_ptr<DataGuard> guard_if_key(Bus& bus, const std::string& program,
 
 int with_lab_access(const std::string& program, const KeyOptions& options,
                     const std::function<int(LabAccess&)>& body) {
-  std::optional<LabKey> key;
+  std::optional<Credentials> credentials;
   if (options.insecure) {
     spdlog::warn(
         "INSECURE: running without a lab key (--insecure-no-key): nothing it sends is signed or "
@@ -64,7 +70,7 @@ int with_lab_access(const std::string& program, const KeyOptions& options,
     std::string path;
     try {
       path = options.path.empty() ? default_key_path() : options.path;
-      key = LabKey::load(path);
+      credentials = load_key_file(path, program);
     } catch (const LabKeyError& e) {
       std::error_code ec;
       const bool missing = path.empty() || !std::filesystem::exists(path, ec);
@@ -77,7 +83,7 @@ int with_lab_access(const std::string& program, const KeyOptions& options,
       return kExitNoKey;
     }
   }
-  LabAccess lab(std::move(key), instance_name(program));
+  LabAccess lab(std::move(credentials), instance_name(program));
   return body(lab);
 }
 

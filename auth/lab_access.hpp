@@ -1,11 +1,13 @@
 #pragma once
 
-/// What a program that sends or receives commands holds of the lab key: a signer for what it
-/// sends and a verifier for what it receives — or, with `--insecure-no-key`, neither: it sends
-/// unsigned and accepts everything, after a loud warning. Every such program takes the same two
-/// flags (`--key PATH`, default $SG_LAB_KEY else ~/.config/stereograsp/lab.key, and
-/// `--insecure-no-key`), and without a usable key and without the flag it exits 2 with one line
-/// that says how to make one.
+/// What a program holds of the lab's secrets: its credentials (auth/credentials_file.hpp), which
+/// guard its bus (every datum vouched for) and, for a program that sends or obeys commands, a
+/// signer for what it sends and a verifier for what it receives — or, with `--insecure-no-key`,
+/// nothing: it vouches for nothing, sends unsigned and believes everything, after a loud warning.
+/// Every program takes the same two flags (`--key PATH`: the lab key, or the credentials sg-lab
+/// made for it; default $SG_LAB_KEY else ~/.config/stereograsp/lab.key; and `--insecure-no-key`),
+/// and without a usable key and without the flag it exits 2 with one line that says how to make
+/// one.
 ///
 ///     sg::auth::KeyOptions key_options;
 ///     sg::auth::add_key_options(app, key_options);
@@ -27,6 +29,7 @@
 #include <string>
 
 #include "auth/command_auth.hpp"
+#include "auth/credentials_file.hpp"
 #include "auth/data_auth.hpp"
 #include "auth/lab_key.hpp"
 #include "common/bus.hpp"
@@ -48,12 +51,15 @@ void add_key_options(CLI::App& app, KeyOptions& options);
 /// The signer and verifier of one program, or neither (insecure).
 class LabAccess {
  public:
-  /// With a key: signs as `sender`, verifies with `settings`. Without: signs nothing (only sets
-  /// the sender) and accepts every command.
-  LabAccess(std::optional<LabKey> key, std::string sender, VerifierSettings settings = {});
+  /// With credentials: signs as `sender` and verifies with `settings` under their command key.
+  /// Without: signs nothing (only sets the sender) and accepts every command.
+  LabAccess(std::optional<Credentials> credentials, std::string sender,
+            VerifierSettings settings = {});
 
-  bool secure() const { return key_.has_value(); }
-  const std::optional<LabKey>& key() const { return key_; }
+  bool secure() const { return credentials_.has_value(); }
+  /// The key commands are signed and checked with (none when insecure, or when the credentials
+  /// are of a process that neither sends nor obeys commands).
+  const std::optional<LabKey>& command_key() const;
   /// The name this program vouches as: its sender up to the '@' ("sg-grasp").
   std::string identity() const { return sender_.substr(0, sender_.find('@')); }
 
@@ -66,11 +72,15 @@ class LabAccess {
   /// The verifier (nullptr when insecure), for its counts.
   const CommandVerifier* verifier() const { return verifier_ ? &*verifier_ : nullptr; }
 
-  /// Signs `command` for `channel` (insecure: sets its sender only).
+  /// Signs `command` for `channel` (insecure: sets its sender only). Throws std::runtime_error
+  /// when the credentials hold no command key.
   template <class M>
   void sign(const std::string& channel, M& command) {
     if (signer_) {
       signer_->sign(channel, command);
+    } else if (secure()) {
+      throw std::runtime_error("the credentials of " + identity() +
+                               " hold no command key: it may not send commands");
     } else {
       command.sender = sender_;
     }
@@ -79,13 +89,14 @@ class LabAccess {
   /// "" when `command` may be obeyed (always when insecure), else "unauthenticated: <why>".
   template <class M>
   std::string refusal(const std::string& channel, const M& command, int64_t now_utime) {
-    if (!verifier_) return "";
+    if (!verifier_)
+      return secure() ? "unauthenticated: " + identity() + " holds no command key" : "";
     const Verification v = verifier_->verify(channel, command, now_utime);
     return v.accepted() ? "" : "unauthenticated: " + v.reason;
   }
 
  private:
-  std::optional<LabKey> key_;
+  std::optional<Credentials> credentials_;
   std::string sender_;
   std::optional<CommandSigner> signer_;
   std::optional<CommandVerifier> verifier_;

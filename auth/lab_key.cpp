@@ -96,6 +96,51 @@ LabKey& LabKey::operator=(const LabKey& other) {
 }
 LabKey::~LabKey() { sodium_memzero(bytes_.data(), bytes_.size()); }
 
+std::string read_secret_file(const std::string& path, std::size_t limit) {
+  ensure_sodium();
+  Fd f{::open(path.c_str(), O_RDONLY | O_CLOEXEC)};
+  if (f.fd < 0) {
+    if (errno == ENOENT) fail(path, "no such file");
+    fail(path, "cannot open: " + errno_text());
+  }
+  check_mode(f.fd, path);
+  std::string text = read_some(f.fd, limit + 1, path);
+  if (text.size() > limit) {
+    sodium_memzero(text.data(), text.size());
+    fail(path, "more than " + std::to_string(limit) + " bytes");
+  }
+  return text;
+}
+
+void write_secret_file(const std::string& path, const std::string& text) {
+  const std::filesystem::path target(path);
+  std::error_code ec;
+  if (target.has_parent_path() && !std::filesystem::exists(target.parent_path(), ec)) {
+    std::filesystem::create_directories(target.parent_path(), ec);
+    if (ec) fail(path, "cannot create its folder: " + ec.message());
+    std::filesystem::permissions(target.parent_path(), std::filesystem::perms::owner_all, ec);
+  }
+  const std::string temporary = path + ".new";
+  ::unlink(temporary.c_str());
+  create_exclusive(temporary, text);
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    const std::string why = errno_text();
+    ::unlink(temporary.c_str());
+    fail(path, "cannot replace: " + why);
+  }
+}
+
+LabKey command_key(const LabKey& lab) {
+  ensure_sodium();
+  static constexpr char kDomain[] = "sg-command-v1";
+  std::array<uint8_t, LabKey::kSize> bytes{};
+  crypto_generichash(bytes.data(), bytes.size(), reinterpret_cast<const unsigned char*>(kDomain),
+                     sizeof kDomain - 1, lab.bytes().data(), lab.bytes().size());
+  LabKey key(bytes);
+  sodium_memzero(bytes.data(), bytes.size());
+  return key;
+}
+
 LabKey LabKey::load(const std::string& path) {
   ensure_sodium();
   Fd f{::open(path.c_str(), O_RDONLY | O_CLOEXEC)};

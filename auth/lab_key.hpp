@@ -53,6 +53,20 @@ class LabKey {
 /// LabKeyError.
 void write_new_key_file(const std::string& path, bool replace = false);
 
+/// The text of a secret file (a lab key, a process's credentials) of at most `limit` bytes, with
+/// LabKey::load's refusals: missing, unreadable, not a regular file, readable or writable by group
+/// or others, and larger than `limit`. Throws LabKeyError "lab key PATH: ...".
+std::string read_secret_file(const std::string& path, std::size_t limit);
+
+/// Writes `text` to `path`, mode 0600, through a temporary file beside it renamed over it (so a
+/// reader never sees half a file), creating the parent folder (mode 0700). Throws LabKeyError.
+void write_secret_file(const std::string& path, const std::string& text);
+
+/// The key that signs commands (ARM_COMMAND, GRASP_COMMAND): BLAKE2b-256 keyed with the lab key
+/// over "sg-command-v1". Only the processes that send or obey commands hold it, so a host with the
+/// cameras' credentials cannot sign one.
+LabKey command_key(const LabKey& lab);
+
 /// Where programs look for the key: $SG_LAB_KEY when set and not empty, else
 /// $HOME/.config/stereograsp/lab.key. Throws LabKeyError when neither variable is set.
 std::string default_key_path();

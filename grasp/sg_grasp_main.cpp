@@ -80,7 +80,9 @@ int run(const std::string& url, const sg::arm::ArmGeometry& geometry,
   lab.guard(bus);  // believes OBJECT_TRAJECTORY, ARM_STATUS, ... only from their publishers
   bus.announce("sg-grasp");
   sg::grasp::GraspNode node(geometry, settings, sg::now_utime(), 1.0 / status_rate);
-  if (lab.key()) node.require_signed_commands(*lab.key(), "GRASP_COMMAND");
+  if (lab.secure() && !lab.command_key())
+    throw std::runtime_error("the credentials hold no command key: sg-grasp's own are needed");
+  if (lab.command_key()) node.require_signed_commands(*lab.command_key(), "GRASP_COMMAND");
   bus.subscribe<stereograsp::trajectory_t>("OBJECT_TRAJECTORY", [&](const auto& m, const auto&) {
     const std::string why = node.on_trajectory(m, sg::now_utime());
     if (!why.empty()) bus.note_refused("OBJECT_TRAJECTORY", why);  // counted, logged sparingly

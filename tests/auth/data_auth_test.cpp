@@ -150,7 +150,7 @@ TEST(DataAuth, AnotherLabsKeyAndNoTagAreRefused) {
   EXPECT_EQ(verdict(lab.predictor, "OBJECT_POSITION", p), GuardVerdict::kAccepted);
   std::vector<uint8_t> s = payload();
   lab.predictor.vouch("PROCESS_STATUS", s);
-  DataGuard stranger(Credentials{"sg-intruder", {}, {}}, {}, lab.clock, 2);
+  DataGuard stranger(Credentials{"sg-intruder", {}, {}, {}}, {}, lab.clock, 2);
   EXPECT_EQ(verdict(stranger, "PROCESS_STATUS", s), GuardVerdict::kNotAllowed);
   Credentials untagged = credentials_from_lab_key(lab.key, "sg-vision");
   untagged.send.clear();  // vouches as sg-vision, but for no reader

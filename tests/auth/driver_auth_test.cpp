@@ -146,7 +146,7 @@ TEST(DriverAuth, RefusesUnsignedAndForgedExecutesSigned) {
 
   // Signed, as sg-grasp, with the lab key: executed, though a forged sg-grasp sequence of
   // 2^63-1 came first; the arm is at the target.
-  const auth::LabKey key = auth::LabKey::load(key_path);
+  const auth::LabKey key = auth::command_key(auth::LabKey::load(key_path));
   auth::CommandSigner signer(key, "sg-grasp");
   arm_cmd_t real = move(11, "");
   signer.sign("ARM_COMMAND", real);

@@ -175,13 +175,17 @@ TEST(LabAccess, InsecureSignsNothingAndAcceptsAll) {
   EXPECT_EQ(rc, 7);
 }
 
-// With a key: the body's LabAccess signs, and refuses unsigned commands as "unauthenticated: ...".
+// With a key: the LabAccess of a program that sends commands (sg-grasp-ctl) signs, and refuses
+// unsigned commands as "unauthenticated: ...".
 TEST(LabAccess, WithAKeySignsAndChecks) {
   KeyOptions options;
   options.path = test::make_temp_dir() + "/lab.key";
   write_new_key_file(options.path);
-  const int rc = with_lab_access("sg-test", options, [&](LabAccess& lab) {
+  const int rc = with_lab_access("sg-grasp-ctl", options, [&](LabAccess& lab) {
     EXPECT_TRUE(lab.secure());
+    EXPECT_TRUE(lab.command_key().has_value());
+    if (!lab.command_key()) return 1;
+    EXPECT_EQ(lab.command_key()->bytes(), command_key(LabKey::load(options.path)).bytes());
     stereograsp::grasp_command_t unsigned_command{};
     unsigned_command.sender = "sg-test";
     EXPECT_EQ(lab.refusal("GRASP_COMMAND", unsigned_command, 1'000'000).rfind(
@@ -192,6 +196,23 @@ TEST(LabAccess, WithAKeySignsAndChecks) {
     EXPECT_EQ(lab.refusal("GRASP_COMMAND", c, c.auth_counter), "");
     EXPECT_EQ(lab.verifier()->count(Verdict::kAccepted), 1);
     EXPECT_EQ(lab.verifier()->count(Verdict::kUnsigned), 1);
+    return 0;
+  });
+  EXPECT_EQ(rc, 0);
+}
+
+// A program that neither sends nor obeys commands (sg-predictor) holds no command key, even from
+// the lab key: it cannot sign one, and it obeys none.
+TEST(LabAccess, WithoutCommandRightsNoCommandIsSignedOrObeyed) {
+  KeyOptions options;
+  options.path = test::make_temp_dir() + "/lab.key";
+  write_new_key_file(options.path);
+  const int rc = with_lab_access("sg-predictor", options, [&](LabAccess& lab) {
+    EXPECT_TRUE(lab.secure());
+    EXPECT_FALSE(lab.command_key().has_value());
+    stereograsp::grasp_command_t c{};
+    EXPECT_THROW(lab.sign("GRASP_COMMAND", c), std::runtime_error);
+    EXPECT_EQ(lab.refusal("GRASP_COMMAND", c, 1), "unauthenticated: sg-predictor holds no command key");
     return 0;
   });
   EXPECT_EQ(rc, 0);

@@ -184,7 +184,8 @@ class ArmRig {
   std::string dir_;
   std::string url_;
   Bus bus_;
-  auth::CommandSigner signer_{auth::LabKey::load(auth::default_key_path()), "arm_test"};
+  auth::CommandSigner signer_{auth::command_key(auth::LabKey::load(auth::default_key_path())),
+                              "arm_test"};
   std::unique_ptr<Child> sim_;
   std::unique_ptr<Child> driver_;
   arm_status_t status_{};
@@ -314,7 +315,8 @@ class OtherCommander {
       : thread_([url, name](std::stop_token stop) {
           Bus bus(url);
           bus.set_guard(vouching_as("sg-arm-ctl"));
-          auth::CommandSigner signer(auth::LabKey::load(auth::default_key_path()), name);
+          auth::CommandSigner signer(auth::command_key(auth::LabKey::load(auth::default_key_path())),
+                                     name);
           arm_cmd_t c = move_to(1, 0.40, 0.0, 0.35);
           while (!stop.stop_requested()) {
             signer.sign("ARM_COMMAND", c);
