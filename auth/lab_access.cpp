@@ -12,12 +12,14 @@ namespace sg::auth {
 void add_key_options(CLI::App& app, KeyOptions& options) {
   CLI::Option* key = app.add_option(
       "--key", options.path,
-      "lab key file that signs and checks commands, mode 0600 (default: $SG_LAB_KEY, else "
+      "the lab key, or the credentials sg-lab made for this process, mode 0600: what vouches for "
+      "its messages, checks what it hears and signs its commands (default: $SG_LAB_KEY, else "
       "~/.config/stereograsp/lab.key; make one with sg-keygen)");
   CLI::Option* insecure = app.add_flag(
-      "--insecure-no-key", options.insecure,
-      "run without a lab key: send commands unsigned and accept unsigned ones (anyone on the "
-      "network can then command the arm)");
+      "--insecure-no-key",
+      options.insecure,
+      "run without a lab key: vouch for nothing, sign nothing, and believe and obey whatever "
+      "arrives (anyone on the network can then steer the arm)");
   key->excludes(insecure);
 }
 

@@ -15,7 +15,9 @@
 #include "common/clock.hpp"
 #include "common/process_watch.hpp"
 #include "common/shutdown.hpp"
+#include "auth/data_auth.hpp"
 #include "lab/host_shell.hpp"
+#include "lab/lab_credentials.hpp"
 
 namespace sg::lab {
 namespace fs = std::filesystem;
@@ -57,7 +59,10 @@ std::string this_hostname() {
 /// ssh calls would leave gaps in its heartbeats that a recorded session would list).
 class LabSession::Listener {
  public:
-  Listener(const std::string& url, bool take_part) : bus(url) {
+  Listener(const std::string& url, bool take_part, const std::optional<auth::LabKey>& key)
+      : bus(url) {
+    if (key) bus.set_guard(std::make_shared<auth::DataGuard>(
+                 auth::credentials_from_lab_key(*key, "sg-lab")));
     bus.subscribe<stereograsp::process_status_t>(
         "PROCESS_STATUS", [this](const stereograsp::process_status_t& s, const ReceiveInfo& info) {
           watch.receive(s, info.recv_utime);
@@ -101,7 +106,7 @@ LabSession::LabSession(LabFile lab, std::string project, std::ostream& out, std:
 LabSession::~LabSession() = default;
 
 LabSession::Listener& LabSession::listener(bool take_part) {
-  if (!listener_) listener_ = std::make_unique<Listener>(lab_.bus, take_part);
+  if (!listener_) listener_ = std::make_unique<Listener>(lab_.bus, take_part, lab_key_);
   return *listener_;
 }
 
@@ -111,6 +116,12 @@ std::vector<std::string> LabSession::argv_of(const ProcessSpec& p) const {
   if (argv[0].find('/') == std::string::npos) argv[0] = std::string(kBin) + "/" + argv[0];
   if (!lab_.bus.empty()) argv.insert(argv.begin() + 1, {"--lcm-url", lab_.bus});
   if (!lab_.config.empty()) argv.insert(argv.begin() + 1, {"--config", lab_.config});
+  if (identity_of(p).empty() || names_its_key(p)) return argv;
+  const auto credentials = credentials_.find(p.name);
+  if (credentials != credentials_.end())
+    argv.insert(argv.begin() + 1, {"--key", credentials->second});
+  else if (!lab_key_)
+    argv.insert(argv.begin() + 1, "--insecure-no-key");
   return argv;
 }
 
@@ -316,6 +327,29 @@ void LabSession::copy_files() {
   }
 }
 
+void LabSession::distribute_credentials() {
+  credentials_.clear();
+  if (!lab_key_) {
+    out_ << "sg-lab: INSECURE: no lab key: every process starts with --insecure-no-key\n";
+    return;
+  }
+  const std::string stage = state_ + "/" + session_ + "/stage";
+  const auto paths = stage_credentials(lab_, *lab_key_, session_, stage);
+  std::map<std::string, std::vector<std::string>> by_host;
+  for (const ProcessSpec& p : lab_.processes)
+    if (paths.count(p.name) != 0) by_host[p.host].push_back(paths.at(p.name));
+  for (const auto& [host, files] : by_host) {
+    const CommandResult r = make_shell(lab_.host(host), project_)->copy_all(stage, files,
+                                                                            kShellTimeout);
+    if (!r.ok()) throw LabError("copying credentials to " + host + ": " + r.describe());
+  }
+  std::error_code ec;
+  fs::remove_all(stage, ec);  // the hosts have them; the lab key can make them again
+  credentials_ = paths;
+  out_ << "sg-lab: credentials for " << paths.size() << " process(es) on " << by_host.size()
+       << " host(s)\n";
+}
+
 void LabSession::up() {
   const auto t0 = Clock::now();
   try {
@@ -331,6 +365,7 @@ void LabSession::up() {
   preflight();
   session_ = session_name(lab_.lab);
   copy_files();
+  distribute_credentials();
   out_ << "sg-lab: lab '" << lab_.lab << "', session " << session_ << "\n" << std::flush;
   listener();  // listening before anything starts
   try {

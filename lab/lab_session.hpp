@@ -21,12 +21,15 @@
 /// <lab>.current there points at it; each host keeps its processes' logs in the same folder of
 /// its own checkout.
 
+#include <map>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <set>
 #include <string>
 #include <vector>
 
+#include "auth/lab_key.hpp"
 #include "lab/lab_file.hpp"
 
 namespace sg::lab {
@@ -61,6 +64,11 @@ class LabSession {
   /// Restarts one process (its supervisor stops and starts it) and waits until it is ready.
   void restart(const std::string& name);
 
+  /// The lab key that up() makes each process's credentials from (lab/lab_credentials.hpp),
+  /// and sg-lab's own listener vouches and checks with; none: up() starts every process that
+  /// takes a key with --insecure-no-key, and the listener believes everything.
+  void use_lab_key(std::optional<auth::LabKey> key) { lab_key_ = std::move(key); }
+
   /// Name of the session folder in use (after up(), or found by the other commands).
   const std::string& session() const { return session_; }
 
@@ -69,6 +77,8 @@ class LabSession {
   Listener& listener(bool take_part = false);
   void preflight();
   void copy_files();
+  /// Makes the processes' credentials and copies them to their hosts (one tar stream a host).
+  void distribute_credentials();
   void start(const ProcessSpec& p);
   void wait_ready(const ProcessSpec& p, const StartedProcess& s, double since);
   void stop(const StartedProcess& s, bool& killed);
@@ -88,6 +98,8 @@ class LabSession {
   std::string session_;  ///< "<lab>-<date>-<time>"
   std::vector<StartedProcess> started_;
   std::unique_ptr<Listener> listener_;
+  std::optional<auth::LabKey> lab_key_;
+  std::map<std::string, std::string> credentials_;  ///< process -> its credentials on its host
 };
 
 /// The recorder as a process of the lab (lcm-logger), named "recorder".

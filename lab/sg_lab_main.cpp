@@ -19,6 +19,7 @@
 #include <iostream>
 #include <regex>
 
+#include "auth/lab_access.hpp"
 #include "common/program.hpp"
 #include "common/shutdown.hpp"
 #include "lab/lab_file.hpp"
@@ -79,6 +80,27 @@ int supervise(Options& o) {
   return sg::lab::supervise(o.supervise);
 }
 
+/// The lab key that `up` makes the processes' credentials from (docs/security.md). Without one:
+/// for `up`, one line on stderr and kExitNoKey (unless --insecure-no-key); for the other
+/// commands, none (they then believe every PROCESS_STATUS they hear).
+std::optional<sg::auth::LabKey> load_lab_key(const sg::auth::KeyOptions& o, bool required,
+                                             bool& failed) {
+  failed = false;
+  if (o.insecure) return std::nullopt;
+  std::string path;
+  try {
+    path = o.path.empty() ? sg::auth::default_key_path() : o.path;
+    return sg::auth::LabKey::load(path);
+  } catch (const sg::auth::LabKeyError& e) {
+    if (!required) return std::nullopt;
+    std::cerr << "sg-lab: error: " << e.what() << "; sg-lab makes each process's credentials "
+              << "from it: make one with `sg-keygen " << path
+              << "` on this machine only, give --key PATH, or run with --insecure-no-key\n";
+    failed = true;
+    return std::nullopt;
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -92,6 +114,8 @@ int main(int argc, char** argv) {
   app.add_option("--state", o.state,
                  "folder of the sessions' records (sg-lab.state, <lab>.current); default: logs/ "
                  "of this checkout");
+  sg::auth::KeyOptions key_options;
+  sg::auth::add_key_options(app, key_options);
   CLI::App* up = app.add_subcommand("up", "Start every process on its host, in order");
   CLI::App* down = app.add_subcommand("down", "Stop every process, the recorder last; report");
   CLI::App* status = app.add_subcommand("status", "Each process's host, state, rates; the clocks");
@@ -117,6 +141,9 @@ int main(int argc, char** argv) {
     }
     sg::install_shutdown_handlers();
     sg::lab::LabSession session(lab, project, std::cout, o.state);
+    bool no_key = false;
+    session.use_lab_key(load_lab_key(key_options, up->parsed(), no_key));
+    if (no_key) return sg::auth::kExitNoKey;
     try {
       if (*up) session.up();
       if (*down) return session.down();
