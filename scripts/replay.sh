@@ -14,6 +14,11 @@
 # replays OBJECT_TRAJECTORY, OBJECT_POSITION and ARM_STATUS into sg-grasp (its commands are
 # recorded, not executed: no arm is on the replay's bus).
 #
+# The replay needs no lab key: it runs in a private network namespace (scripts/multicast.sh run),
+# whose bus nothing outside it can hear or reach, and its processes believe the log as it was
+# recorded (--insecure-no-key; its messages' counters are old, so a guarded process would refuse
+# them as stale: docs/security.md, "Replays").
+#
 # Examples:
 #   scripts/replay.sh logs/20261126-015724-demo.lcmlog
 #   scripts/replay.sh logs/…-demo.lcmlog --from predictor -- --model kalman   # a baseline
@@ -48,9 +53,8 @@ done
 
 bin=build/bin
 [ -x "$bin/sg-report" ] || scripts/bootstrap.sh
-if ! scripts/multicast.sh setup; then
-  echo "replay: no multicast here; replaying in a private network namespace" >&2
-  exec scripts/multicast.sh run "$0" "$log" --port "$port" --speed "$speed" \
+if [ -z "${SG_REPLAY_INSIDE:-}" ]; then  # a bus of its own: never the lab's
+  SG_REPLAY_INSIDE=1 exec scripts/multicast.sh run "$0" "$log" --port "$port" --speed "$speed" \
     ${from:+--from "$from"} ${out:+--out "$out"} ${calibration:+--calibration "$calibration"} \
     -- "${extra[@]}"
 fi
@@ -82,13 +86,15 @@ pids=()
 cleanup() { for p in "${pids[@]}"; do kill -INT "$p" 2>/dev/null || true; done; }
 trap cleanup EXIT
 
-echo "replay: $log from $from on, on $url; recording into $out"
+echo "replay: $log from $from on, on $url in a private network namespace; recording into $out"
+echo "replay: its processes believe the log as recorded (--insecure-no-key): nothing here reaches a lab"
+offline=(--insecure-no-key --log-level error)  # the INSECURE warning said once, above
 lcm-logger --lcm-url="$url" --quiet -f "$out" > /dev/null &
 logger_pid=$!
 pids+=("$logger_pid")
 first=("${extra[@]}")
 if [ "$from" = vision ]; then
-  "$bin/sg-vision" --lcm-url "$url" --calibration "$calibration" --log-level warn "${first[@]}" &
+  "$bin/sg-vision" --lcm-url "$url" --calibration "$calibration" "${offline[@]}" "${first[@]}" &
   pids+=($!)
   first=()
 fi
@@ -96,12 +102,12 @@ if [ "$from" = vision ] || [ "$from" = predictor ]; then
   coefficients=()  # the demo's offline-trained starting coefficients, when they are beside the log
   [ -r "$session.coefficients.yaml" ] && coefficients=(--coefficients "$session.coefficients.yaml")
   # --max-time-offset 0: the log's capture times are old, the plausibility gate must not refuse them
-  "$bin/sg-predictor" --lcm-url "$url" --log-level warn --max-time-offset 0 "${coefficients[@]}" \
+  "$bin/sg-predictor" --lcm-url "$url" "${offline[@]}" --max-time-offset 0 "${coefficients[@]}" \
     "${first[@]}" &
   pids+=($!)
   first=()
 fi
-"$bin/sg-grasp" --lcm-url "$url" --log-level warn "${first[@]}" &
+"$bin/sg-grasp" --lcm-url "$url" "${offline[@]}" "${first[@]}" &
 pids+=($!)
 sleep 1
 lcm-logplayer --lcm-url="$url" --speed="$speed" --regexp="^($played)\$" "$log"
