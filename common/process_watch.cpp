@@ -158,8 +158,8 @@ std::vector<ProcessWatch::HostOffset> ProcessWatch::host_offsets(
 std::string format_processes(const ProcessWatch& watch, int64_t now) {
   std::string out;
   char line[512];
-  std::snprintf(line, sizeof line, "%-28s %-14s %-12s %8s %8s %8s %6s  %s\n", "PROCESS", "HOST",
-                "STATE", "UP", "IN/s", "OUT/s", "BAD", "LAST PROBLEM");
+  std::snprintf(line, sizeof line, "%-28s %-14s %-12s %8s %8s %8s %6s %9s  %s\n", "PROCESS",
+                "HOST", "STATE", "UP", "IN/s", "OUT/s", "BAD", "UNVOUCHED", "LAST PROBLEM");
   out += line;
   for (const ProcessWatch::Process& p : watch.processes()) {
     const auto& s = p.last;
@@ -172,10 +172,12 @@ std::string format_processes(const ProcessWatch& watch, int64_t now) {
     const long long bad = s.decode_errors + s.refused_inputs + s.handler_errors;
     std::string problem = s.last_problem;
     if (!s.state_detail.empty()) problem = s.state_detail + (problem.empty() ? "" : "; " + problem);
-    std::snprintf(line, sizeof line, "%-28s %-14s %-12s %8s %8.1f %8.1f %6lld  %s\n",
+    const std::string unvouched =
+        s.vouched_as.empty() ? "insecure" : std::to_string(s.unvouched_inputs);
+    std::snprintf(line, sizeof line, "%-28s %-14s %-12s %8s %8.1f %8.1f %6lld %9s  %s\n",
                   (s.process + ":" + std::to_string(s.pid)).c_str(), s.host.c_str(), state.c_str(),
                   s.start_utime > 0 && up >= 0 ? duration(up).c_str() : "?", sum(s.rate_in_hz),
-                  sum(s.rate_out_hz), bad, problem.substr(0, 200).c_str());
+                  sum(s.rate_out_hz), bad, unvouched.c_str(), problem.substr(0, 200).c_str());
     out += line;
   }
   return out;

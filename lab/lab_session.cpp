@@ -456,8 +456,9 @@ int LabSession::status(double listen_s) {
   l.watch.check(now);
   bool healthy = true;
   char line[512];
-  std::snprintf(line, sizeof line, "%-12s %-10s %-16s %8s %-12s %8s %8s %8s %5s  %s\n", "NAME",
-                "HOST", "PROGRAM", "PID", "STATE", "UP", "IN/s", "OUT/s", "BAD", "LAST PROBLEM");
+  std::snprintf(line, sizeof line, "%-12s %-10s %-16s %8s %-12s %8s %8s %8s %5s %9s  %s\n",
+                "NAME", "HOST", "PROGRAM", "PID", "STATE", "UP", "IN/s", "OUT/s", "BAD",
+                "UNVOUCHED", "LAST PROBLEM");
   out_ << "lab '" << lab_.lab << "', session " << session_ << "\n" << line;
   const std::set<std::string> up = running();
   for (const StartedProcess& s : started_) {
@@ -472,7 +473,7 @@ int LabSession::status(double listen_s) {
         seen = &q;
     const bool running = up.count(s.name) > 0;
     std::string state = running ? "running" : "exited";
-    std::string uptime = "-", in = "-", out = "-", bad = "-", problem, pid = "-";
+    std::string uptime = "-", in = "-", out = "-", bad = "-", unvouched = "-", problem, pid = "-";
     if (seen && running) {
       const auto& st = seen->last;
       const double silence = (now - seen->last_heard) / 1e6;
@@ -484,6 +485,7 @@ int LabSession::status(double listen_s) {
       for (double r : st.rate_out_hz) rout += r;
       in = fixed(rin), out = fixed(rout);
       bad = std::to_string(st.decode_errors + st.refused_inputs + st.handler_errors);
+      unvouched = st.vouched_as.empty() ? "insecure" : std::to_string(st.unvouched_inputs);
       problem = st.state_detail.empty() ? st.last_problem : st.state_detail;
       pid = std::to_string(st.pid);
       healthy &= state == "ready";
@@ -494,9 +496,9 @@ int LabSession::status(double listen_s) {
       healthy = false;
       problem = "its supervisor is gone (sg-lab logs " + s.name + ")";
     }
-    std::snprintf(line, sizeof line, "%-12s %-10s %-16s %8s %-12s %8s %8s %8s %5s  %s\n",
+    std::snprintf(line, sizeof line, "%-12s %-10s %-16s %8s %-12s %8s %8s %8s %5s %9s  %s\n",
                   s.name.c_str(), s.host.c_str(), p->program().c_str(), pid.c_str(), state.c_str(),
-                  uptime.c_str(), in.c_str(), out.c_str(), bad.c_str(),
+                  uptime.c_str(), in.c_str(), out.c_str(), bad.c_str(), unvouched.c_str(),
                   problem.substr(0, 160).c_str());
     out_ << line;
   }

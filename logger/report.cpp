@@ -253,7 +253,10 @@ Json j_processes(const ProcessesSummary& p) {
                          {"last_s", s.last_s},
                          {"last_state", s.last_state},
                          {"bad", s.bad},
-                         {"last_problem", s.last_problem}});
+                         {"last_problem", s.last_problem},
+                         {"vouched_as", s.vouched_as},
+                         {"unvouched", s.unvouched},
+                         {"refusals", s.refusals}});
   Json clocks = Json::array();
   for (const ProcessWatch::HostOffset& h : p.clocks)
     clocks.push_back({{"host", h.host},
@@ -351,6 +354,12 @@ void md_problems(std::ostream& o, const SessionSummary& s) {
     o << "- " << e << "\n";
     any = true;
   }
+  for (const ProcessSummary& p : s.processes.processes) {
+    for (const std::string& r : p.refusals)
+      o << "- " << md_cell(p.name) << " refused messages nobody it believes vouched for: "
+        << md_cell(r) << "\n";
+    any = any || !p.refusals.empty();
+  }
   if (!any) o << "None.\n";
   for (const UnknownChannel& u : s.lcm_internal)
     o << "\nLCM's own: " << u.name << " (" << u.count << " message(s); normal on udpm).\n";
@@ -361,12 +370,14 @@ void md_problems(std::ostream& o, const SessionSummary& s) {
 void md_processes(std::ostream& o, const ProcessesSummary& p) {
   if (p.processes.empty()) return;
   o << "\n## Processes\n\n"
-    << "| process | host | first s | last s | last state | bad messages | last problem |\n"
-       "|---|---|---:|---:|---|---:|---|\n";
+    << "| process | host | first s | last s | last state | vouched as | unvouched | bad messages "
+       "| last problem |\n"
+       "|---|---|---:|---:|---|---|---:|---:|---|\n";
   for (const ProcessSummary& s : p.processes)
     o << "| " << md_cell(s.name) << " | " << md_cell(s.host) << " | " << num(s.first_s, 1) << " | "
-      << num(s.last_s, 1) << " | " << s.last_state << " | " << s.bad << " | "
-      << md_cell(s.last_problem) << " |\n";
+      << num(s.last_s, 1) << " | " << s.last_state << " | "
+      << (s.vouched_as.empty() ? "(nobody: insecure)" : md_cell(s.vouched_as)) << " | "
+      << s.unvouched << " | " << s.bad << " | " << md_cell(s.last_problem) << " |\n";
   if (!p.events.empty()) {
     o << "\n";
     for (const std::string& e : p.events) o << "- " << md_cell(e) << "\n";

@@ -228,6 +228,11 @@ struct ProcessSummary {
   std::string last_state;          ///< "ready", "stopping", ...
   int64_t bad = 0;                 ///< refused, undecodable and failed messages, as it counted
   std::string last_problem;
+  std::string vouched_as;  ///< the identity it vouched as; "" when it ran without credentials
+  int64_t unvouched = 0;   ///< messages it refused as not vouched for (docs/security.md)
+  /// Those refusals, a line a (channel, claimed sender, verdict): "OBJECT_TRAJECTORY from
+  /// 'sg-camera-sim': 300 not allowed".
+  std::vector<std::string> refusals;
 };
 
 /// The processes and clocks of a session, from PROCESS_STATUS.

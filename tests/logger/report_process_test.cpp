@@ -251,7 +251,16 @@ TEST(ReportLive, RecordedSessionFromTheRealPredictor) {
       });
   bus.subscribe_raw("OBJECT_POSITION", [&](const RawMessage&) { ++positions_heard; });
   constexpr int kSent = 150;  // 5 s at 30 Hz, real time
-  const int64_t start = now_utime();
+  constexpr int kRogue = 20;  // positions from a host without credentials, before the stream
+  const int64_t start = now_utime() + 500'000;
+  Bus rogue(test_url(7922));
+  for (int k = 0; k < kRogue; ++k) {
+    stereograsp::point3_t p{};
+    p.utime = start - 2'000'000 + k * 1000;
+    p.visible = true;
+    p.position[0] = 0.65, p.position[2] = 0.2;
+    rogue.publish("OBJECT_POSITION", p);
+  }
   for (int k = 0; k < kSent; ++k) {
     stereograsp::point3_t p{};
     p.utime = start + static_cast<int64_t>(k) * 33'333;
@@ -318,6 +327,18 @@ TEST(ReportLive, RecordedSessionFromTheRealPredictor) {
   EXPECT_GT(j["prediction"][0]["vs_measurement_m"]["count"].get<int>(), 5);
   EXPECT_LT(j["prediction"][0]["vs_measurement_m"]["rms"].get<double>(), 0.05);
   EXPECT_EQ(j["unknown_channels"].size(), 0u);
+  // sg-predictor vouched as itself and refused the rogue host's positions, by channel and why.
+  const Json* refusing = nullptr;
+  for (const Json& p : j["processes"]["processes"])
+    if (p["name"].get<std::string>().rfind("sg-predictor@", 0) == 0) refusing = &p;
+  ASSERT_NE(refusing, nullptr) << j["processes"].dump();
+  EXPECT_EQ((*refusing)["vouched_as"], "sg-predictor");
+  EXPECT_EQ((*refusing)["unvouched"], kRogue);
+  EXPECT_EQ((*refusing)["refusals"], Json::array({"OBJECT_POSITION: 20 unsigned"}));
+  EXPECT_NE(read_text(dir + "/live.report/report.md")
+                .find("refused messages nobody it believes vouched for: OBJECT_POSITION: 20 "
+                      "unsigned"),
+            std::string::npos);
 
   const ProcessResult exported =
       run({program("sg-report"), "export", log, "--channel", "OBJECT_TRAJECTORY", "--csv"});
