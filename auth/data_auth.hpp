@@ -165,6 +165,27 @@ class DataGuard final : public MessageGuard {
   uint64_t accepted_ = 0;
 };
 
+/// A guard for a tool that stands in for one of the lab's processes (a benchmark feeding frames
+/// as sg-camera-sim, a test harness): it vouches for what it publishes as that identity with a
+/// DataGuard, and believes whatever arrives, trailers taken off. It looks; it does not steer.
+class VouchingPublisher final : public MessageGuard {
+ public:
+  explicit VouchingPublisher(Credentials credentials) : inner_(std::move(credentials)) {}
+  const std::string& identity() const override { return inner_.identity(); }
+  void vouch(const std::string& channel, std::vector<uint8_t>& message) override {
+    inner_.vouch(channel, message);
+  }
+  GuardResult check(const std::string&, const uint8_t* data, std::size_t size, int64_t) override {
+    GuardResult r;
+    r.payload_size = vouched_payload_size(data, size);
+    return r;
+  }
+  DataGuard& inner() { return inner_; }
+
+ private:
+  DataGuard inner_;
+};
+
 /// The one-time key k of a message (above), for tests and the fuzzer.
 std::array<uint8_t, 32> one_time_key(const PairKey& key, const std::string& channel,
                                      const VouchTrailer& trailer);

@@ -141,6 +141,22 @@ LabKey command_key(const LabKey& lab) {
   return key;
 }
 
+LabKey generation_key(const LabKey& lab, uint32_t generation) {
+  if (generation == 0) return lab;
+  ensure_sodium();
+  static constexpr char kDomain[] = "sg-generation-v1";
+  unsigned char message[sizeof kDomain - 1 + 4];
+  std::memcpy(message, kDomain, sizeof kDomain - 1);
+  for (int i = 0; i < 4; ++i)
+    message[sizeof kDomain - 1 + i] = static_cast<unsigned char>(generation >> (24 - 8 * i));
+  std::array<uint8_t, LabKey::kSize> bytes{};
+  crypto_generichash(bytes.data(), bytes.size(), message, sizeof message, lab.bytes().data(),
+                     lab.bytes().size());
+  LabKey key(bytes);
+  sodium_memzero(bytes.data(), bytes.size());
+  return key;
+}
+
 LabKey LabKey::load(const std::string& path) {
   ensure_sodium();
   Fd f{::open(path.c_str(), O_RDONLY | O_CLOEXEC)};

@@ -67,6 +67,11 @@ void write_secret_file(const std::string& path, const std::string& text);
 /// cameras' credentials cannot sign one.
 LabKey command_key(const LabKey& lab);
 
+/// The lab key of `generation`: the lab key itself for 0, else BLAKE2b-256 keyed with it over
+/// "sg-generation-v1" || be32 generation. `sg-lab revoke` moves a lab to the next generation, so
+/// the credentials of the one it revokes, derived from the last, no longer match anyone's.
+LabKey generation_key(const LabKey& lab, uint32_t generation);
+
 /// Where programs look for the key: $SG_LAB_KEY when set and not empty, else
 /// $HOME/.config/stereograsp/lab.key. Throws LabKeyError when neither variable is set.
 std::string default_key_path();

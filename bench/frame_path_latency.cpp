@@ -5,7 +5,9 @@
 // sg-vision's own figure, second image received -> OBJECT_POSITION handed to the bus, from its
 // summary. Five runs: JPEG with only the search windows decoded (vision.decode: region, the
 // default), the camera channels read on sg-vision's own socket (vision.camera_read: direct, the
-// default) and its decode workers awake when a pair is due (vision.busy_wait_ms: 1, the default);
+// default) and its decode workers awake when a pair is due (vision.busy_wait_ms: 1, the default),
+// every message vouched for (the frames as sg-camera-sim's: docs/security.md); the same with
+// every program run --insecure-no-key and nothing vouched for (the baseline for vouching);
 // the same read through LCM's subscription (the baseline for the direct read); the same with
 // the workers asleep until a frame comes (busy_wait_ms 0); JPEG decoded whole (the baseline for
 // the windows); raw BGR8. The frames are the simulated lab's, rendered and
@@ -32,6 +34,7 @@
 #include <sstream>
 #include <thread>
 
+#include "auth/data_auth.hpp"
 #include "common/bus.hpp"
 #include "common/clock.hpp"
 #include "common/latency_record.hpp"
@@ -129,6 +132,7 @@ bool wait_ready(sg::Bus& bus, bool& vision, bool& predictor) {
 /// How the runs go: the bus, the frames' rate and count, sg-vision's real-time priority.
 struct RunSettings {
   std::string url, dir;
+  std::string key;  ///< the lab key file the programs and the frames are vouched with
   int pairs = 300;
   double rate = 20;
   int realtime_priority = 0;
@@ -138,6 +142,7 @@ struct RunSettings {
 /// How sg-vision runs: vision.decode, vision.camera_read, vision.busy_wait_ms ("": the default).
 struct VisionVariant {
   std::string decode = "region", camera_read = "direct", busy_wait_ms;
+  bool vouched = true;  ///< false: every program with --insecure-no-key, frames unvouched
 };
 
 void run(const RunSettings& rs, const std::vector<std::array<image_t, 2>>& frames,
@@ -146,6 +151,12 @@ void run(const RunSettings& rs, const std::vector<std::array<image_t, 2>>& frame
   const int pairs = rs.pairs;
   const double rate = rs.rate;
   sg::Bus bus(url);
+  if (variant.vouched)  // the frames come as sg-camera-sim's
+    bus.set_guard(std::make_shared<sg::auth::VouchingPublisher>(
+        sg::auth::credentials_from_lab_key(sg::auth::LabKey::load(rs.key), "sg-camera-sim")));
+  const std::vector<std::string> key =
+      variant.vouched ? std::vector<std::string>{"--key", rs.key}
+                      : std::vector<std::string>{"--insecure-no-key"};
   bool vision_up = false, predictor_up = false;
   bus.subscribe<stereograsp::process_status_t>("PROCESS_STATUS", [&](const auto& m, const auto&) {
     vision_up |= m.process == "sg-vision", predictor_up |= m.process == "sg-predictor";
@@ -171,10 +182,12 @@ void run(const RunSettings& rs, const std::vector<std::array<image_t, 2>>& frame
                                           std::to_string(rs.realtime_priority)};
   if (!variant.busy_wait_ms.empty())
     vision_args.insert(vision_args.end(), {"--busy-wait-ms", variant.busy_wait_ms});
+  vision_args.insert(vision_args.end(), key.begin(), key.end());
+  std::vector<std::string> predictor_args = {"--config", dir + "/predictor.yaml", "--lcm-url", url,
+                                             "--log-level", "error"};
+  predictor_args.insert(predictor_args.end(), key.begin(), key.end());
   Program vision("sg-vision", vision_args, dir + "/vision.out");
-  Program predictor("sg-predictor",
-                    {"--config", dir + "/predictor.yaml", "--lcm-url", url, "--log-level", "warn"},
-                    dir + "/predictor.out");
+  Program predictor("sg-predictor", predictor_args, dir + "/predictor.out");
   if (!wait_ready(bus, vision_up, predictor_up))
     throw std::runtime_error("the programs did not start");
   const auto period = std::chrono::duration<double>(1.0 / rate);
@@ -230,6 +243,17 @@ void print(const Run& r) {
   std::printf("%-22s %58s   sg-vision's CPU time:    %s\n", "", "", r.vision_cpu.c_str());
 }
 
+/// The lab key: $SG_LAB_KEY or ~/.config/stereograsp/lab.key when there, else one made in `dir`.
+std::string lab_key(const std::string& dir) {
+  try {
+    const std::string path = sg::auth::default_key_path();
+    if (std::filesystem::exists(path)) return path;
+  } catch (const sg::auth::LabKeyError&) {
+  }
+  sg::auth::write_new_key_file(dir + "/lab.key");
+  return dir + "/lab.key";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -261,18 +285,20 @@ int main(int argc, char** argv) {
     std::ofstream(dir + "/predictor.yaml") << "predictor:\n  period: " << 1.0 / rate << "\n";
     std::printf("rendering and encoding 60 stereo frames...\n");
     const Frames frames = render(dir + "/cams.yaml");
-    std::vector<Run> runs(region_only ? 3 : 5);
+    std::vector<Run> runs(region_only ? 4 : 6);
     runs[0].name = "JPEG, windows decoded";
-    runs[1].name = "... read through LCM";
-    runs[2].name = "... asleep till frames";
-    const RunSettings rs{url, dir, pairs, rate, realtime};
+    runs[1].name = "... not vouched for";
+    runs[2].name = "... read through LCM";
+    runs[3].name = "... asleep till frames";
+    const RunSettings rs{url, dir, lab_key(dir), pairs, rate, realtime};
     run(rs, frames.jpeg, {}, runs[0]);
-    run(rs, frames.jpeg, {"region", "lcm", ""}, runs[1]);
-    run(rs, frames.jpeg, {"region", "direct", "0"}, runs[2]);
+    run(rs, frames.jpeg, {"region", "direct", "", false}, runs[1]);
+    run(rs, frames.jpeg, {"region", "lcm", ""}, runs[2]);
+    run(rs, frames.jpeg, {"region", "direct", "0"}, runs[3]);
     if (!region_only) {
-      runs[3].name = "JPEG, whole frames", runs[4].name = "raw BGR8";
-      run(rs, frames.jpeg, {"full", "direct", ""}, runs[3]);
-      run(rs, frames.raw, {}, runs[4]);
+      runs[4].name = "JPEG, whole frames", runs[5].name = "raw BGR8";
+      run(rs, frames.jpeg, {"full", "direct", ""}, runs[4]);
+      run(rs, frames.raw, {}, runs[5]);
     }
     std::printf(
         "\n%d pairs at %.0f Hz, one host, sg-vision %s, ms from the frames' publication "

@@ -106,7 +106,7 @@ LabSession::LabSession(LabFile lab, std::string project, std::ostream& out, std:
 LabSession::~LabSession() = default;
 
 LabSession::Listener& LabSession::listener(bool take_part) {
-  if (!listener_) listener_ = std::make_unique<Listener>(lab_.bus, take_part, lab_key_);
+  if (!listener_) listener_ = std::make_unique<Listener>(lab_.bus, take_part, current_key());
   return *listener_;
 }
 
@@ -327,14 +327,27 @@ void LabSession::copy_files() {
   }
 }
 
-void LabSession::distribute_credentials() {
+uint32_t LabSession::generation() const {
+  std::ifstream f(fs::path(state_) / (lab_.lab + ".generation"));
+  unsigned long g = 0;
+  return f >> g && g < 0xffffffffUL ? static_cast<uint32_t>(g) : 0;
+}
+
+std::optional<auth::LabKey> LabSession::current_key() const {
+  if (!lab_key_) return std::nullopt;
+  return auth::generation_key(*lab_key_, generation());
+}
+
+void LabSession::distribute_credentials(const std::string& skip) {
   credentials_.clear();
   if (!lab_key_) {
     out_ << "sg-lab: INSECURE: no lab key: every process starts with --insecure-no-key\n";
     return;
   }
   const std::string stage = state_ + "/" + session_ + "/stage";
-  const auto paths = stage_credentials(lab_, *lab_key_, session_, stage);
+  LabFile others = lab_;
+  std::erase_if(others.processes, [&](const ProcessSpec& p) { return p.name == skip; });
+  const auto paths = stage_credentials(others, *current_key(), session_, stage);
   std::map<std::string, std::vector<std::string>> by_host;
   for (const ProcessSpec& p : lab_.processes)
     if (paths.count(p.name) != 0) by_host[p.host].push_back(paths.at(p.name));
@@ -434,6 +447,31 @@ void LabSession::restart(const std::string& name) {
     return;
   }
   throw LabError("no process '" + name + "' in session " + session_);
+}
+
+void LabSession::revoke(const std::string& name) {
+  load_state();
+  if (!lab_key_) throw LabError("revoke needs the lab key (--key, $SG_LAB_KEY)");
+  const ProcessSpec* p = lab_.process(name);
+  if (!p || identity_of(*p).empty())
+    throw LabError("no process '" + name + "' with credentials in " + lab_.path);
+  bool killed = false;
+  for (const StartedProcess& s : started_)
+    if (s.name == name) stop(s, killed);
+  std::erase_if(started_, [&](const StartedProcess& s) { return s.name == name; });
+  save_state();
+  const uint32_t next = generation() + 1;
+  std::ofstream(fs::path(state_) / (lab_.lab + ".generation")) << next << "\n";
+  distribute_credentials(name);
+  make_shell(lab_.host(p->host), project_)
+      ->run("rm -f " + shell_quote(credentials_path(session_, name)), kShellTimeout);
+  out_ << "sg-lab: " << name << " revoked: stopped, its credentials deleted on " << p->host
+       << "; the lab's keys are now of generation " << next << "\n" << std::flush;
+  for (const ProcessSpec& q : lab_.processes) {
+    const bool running = std::any_of(started_.begin(), started_.end(),
+                                     [&](const StartedProcess& s) { return s.name == q.name; });
+    if (running && credentials_.count(q.name) != 0) restart(q.name);
+  }
 }
 
 int LabSession::logs(const std::string& name, int lines) {

@@ -63,6 +63,13 @@ class LabSession {
   int logs(const std::string& name, int lines);
   /// Restarts one process (its supervisor stops and starts it) and waits until it is ready.
   void restart(const std::string& name);
+  /// Revokes one process's credentials (docs/security.md): stops it, moves the lab to the next
+  /// generation of keys (`<state>/<lab>.generation`), gives every other process new credentials
+  /// and restarts it, and deletes the revoked ones from its host. Its old credentials then match
+  /// nobody's: whoever holds them is refused ("bad tag") on every channel. Needs the lab key.
+  void revoke(const std::string& name);
+  /// The lab's key generation (0 until a revoke).
+  uint32_t generation() const;
 
   /// The lab key that up() makes each process's credentials from (lab/lab_credentials.hpp),
   /// and sg-lab's own listener vouches and checks with; none: up() starts every process that
@@ -77,8 +84,11 @@ class LabSession {
   Listener& listener(bool take_part = false);
   void preflight();
   void copy_files();
-  /// Makes the processes' credentials and copies them to their hosts (one tar stream a host).
-  void distribute_credentials();
+  /// Makes the processes' credentials (but `skip`'s) from the current generation's key and
+  /// copies them to their hosts (one tar stream a host).
+  void distribute_credentials(const std::string& skip = "");
+  /// The lab key of the current generation (none without a lab key).
+  std::optional<auth::LabKey> current_key() const;
   void start(const ProcessSpec& p);
   void wait_ready(const ProcessSpec& p, const StartedProcess& s, double since);
   void stop(const StartedProcess& s, bool& killed);

@@ -128,6 +128,9 @@ int main(int argc, char** argv) {
   logs->add_option("-n,--lines", o.lines, "lines")->check(CLI::Range(1, 100000));
   CLI::App* restart = app.add_subcommand("restart", "Restart one process and wait until ready");
   restart->add_option("NAME", o.name, "the process")->required();
+  CLI::App* revoke = app.add_subcommand(
+      "revoke", "Stop one process and revoke its credentials: every other one gets new keys");
+  revoke->add_option("NAME", o.name, "the process")->required();
   CLI::App* check = app.add_subcommand("check", "Read and check the lab file; start nothing");
   CLI::App* supervise_cmd = add_supervise(app, o);
 
@@ -142,7 +145,7 @@ int main(int argc, char** argv) {
     sg::install_shutdown_handlers();
     sg::lab::LabSession session(lab, project, std::cout, o.state);
     bool no_key = false;
-    session.use_lab_key(load_lab_key(key_options, up->parsed(), no_key));
+    session.use_lab_key(load_lab_key(key_options, up->parsed() || revoke->parsed(), no_key));
     if (no_key) return sg::auth::kExitNoKey;
     try {
       if (*up) session.up();
@@ -151,6 +154,7 @@ int main(int argc, char** argv) {
       if (*watch) return session.watch();
       if (*logs) return session.logs(o.name, o.lines);
       if (*restart) session.restart(o.name);
+      if (*revoke) session.revoke(o.name);
     } catch (const sg::lab::LabError& e) {  // may end with a log's last lines: keep them
       std::cerr << "sg-lab: error: " << e.what() << "\n";
       return 1;

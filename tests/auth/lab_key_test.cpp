@@ -4,6 +4,7 @@
 #include "auth/lab_key.hpp"
 
 #include <gtest/gtest.h>
+#include <sodium.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -216,6 +217,25 @@ TEST(LabAccess, WithoutCommandRightsNoCommandIsSignedOrObeyed) {
     return 0;
   });
   EXPECT_EQ(rc, 0);
+}
+
+// The keys of a lab's generations: generation 0 is the lab key; each other one is the documented
+// BLAKE2b of it, and differs from the others; the command key is BLAKE2b of its own label.
+TEST(LabKey, GenerationsAndTheCommandKeyAreTheDocumentedBlake2b) {
+  std::array<uint8_t, LabKey::kSize> b{};
+  b.fill(3);
+  const LabKey lab(b);
+  EXPECT_EQ(generation_key(lab, 0).bytes(), lab.bytes());
+  const std::string label = std::string("sg-generation-v1") + std::string("\0\0\0\x02", 4);
+  std::array<uint8_t, 32> two{};
+  crypto_generichash(two.data(), 32, reinterpret_cast<const unsigned char*>(label.data()),
+                     label.size(), lab.bytes().data(), 32);
+  EXPECT_EQ(generation_key(lab, 2).bytes(), two);
+  EXPECT_NE(generation_key(lab, 1).bytes(), generation_key(lab, 2).bytes());
+  std::array<uint8_t, 32> command{};
+  crypto_generichash(command.data(), 32, reinterpret_cast<const unsigned char*>("sg-command-v1"),
+                     13, lab.bytes().data(), 32);
+  EXPECT_EQ(command_key(lab).bytes(), command);
 }
 
 }  // namespace

@@ -1,9 +1,9 @@
 #pragma once
 
-/// For test harnesses that stand in for one of the lab's processes on a guarded bus: a guard
-/// that vouches for what the harness publishes as `identity` under a lab key (the process tests'
-/// $SG_LAB_KEY by default), and believes whatever arrives, trailers taken off: a harness watches,
-/// it does not steer. The product's own processes use auth::DataGuard on both sides.
+/// For test harnesses that stand in for one of the lab's processes on a guarded bus: the
+/// product's auth::VouchingPublisher as `identity` under a lab key (the process tests'
+/// $SG_LAB_KEY by default): it vouches for what the harness publishes and believes whatever
+/// arrives. The product's own processes use auth::DataGuard on both sides.
 ///
 ///     sg::Bus bus(url);
 ///     bus.set_guard(sg::test::vouching_as("sg-vision"));   // the predictor believes these
@@ -21,24 +21,7 @@
 
 namespace sg::test {
 
-class HarnessGuard final : public MessageGuard {
- public:
-  HarnessGuard(const auth::LabKey& key, const std::string& identity)
-      : inner_(auth::credentials_from_lab_key(key, identity)) {}
-  const std::string& identity() const override { return inner_.identity(); }
-  void vouch(const std::string& channel, std::vector<uint8_t>& message) override {
-    inner_.vouch(channel, message);
-  }
-  GuardResult check(const std::string&, const uint8_t* data, std::size_t size, int64_t) override {
-    GuardResult r;
-    r.payload_size = vouched_payload_size(data, size);
-    return r;
-  }
-  auth::DataGuard& inner() { return inner_; }
-
- private:
-  auth::DataGuard inner_;
-};
+using HarnessGuard = auth::VouchingPublisher;
 
 /// The lab key of the process tests ($SG_LAB_KEY), or `path`.
 inline auth::LabKey test_lab_key(const std::string& path = "") {
@@ -51,7 +34,8 @@ inline auth::LabKey test_lab_key(const std::string& path = "") {
 
 inline std::shared_ptr<HarnessGuard> vouching_as(const std::string& identity,
                                                  const std::string& key_path = "") {
-  return std::make_shared<HarnessGuard>(test_lab_key(key_path), identity);
+  return std::make_shared<HarnessGuard>(
+      auth::credentials_from_lab_key(test_lab_key(key_path), identity));
 }
 
 /// The refusals a PROCESS_STATUS reports on `channel` with `verdict` (any sender).
