@@ -22,6 +22,7 @@
 #include "common/bus_check.hpp"
 #include "fuzz/signed_commands.hpp"
 #include "fuzz/vouched_messages.hpp"
+#include "auth/credentials_file.hpp"
 #include "predictor/offline_training.hpp"
 #include "sim/c550_controller.hpp"
 #include "sim/c550_emulator.hpp"
@@ -226,6 +227,15 @@ void vouched_messages(const fs::path& out) {
   save(out / "vouch_check/unvouched", records({plain}));
 }
 
+/// credentials: sg-grasp's (with a command key) and sg-vision's, as sg-lab writes them.
+void credentials(const fs::path& out) {
+  for (const char* who : {"sg-grasp", "sg-vision"}) {
+    const std::string text = sg::auth::format_credentials(
+        sg::auth::credentials_from_lab_key(sg::fuzz::fuzz_key(), who), "sg_fuzz_seeds");
+    save(out / "credentials" / (std::string(who) + ".cred"), Bytes(text.begin(), text.end()));
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -240,5 +250,6 @@ int main(int argc, char** argv) {
   coefficients(out);
   signed_commands(out);
   vouched_messages(out);
+  credentials(out);
   return 0;
 }

@@ -5,6 +5,7 @@
 
 #include <fstream>
 
+#include "auth/data_auth.hpp"
 #include "tests/support/field_dump.hpp"
 #include "tests/support/sample_messages.hpp"
 #include "tests/support/subprocess.hpp"
@@ -36,6 +37,31 @@ TEST(JavaDecode, EveryTypeDecodesToEqualFieldsThroughLcmSpysTypeDatabase) {
   const ProcessResult java = run(argv, std::chrono::seconds(120));
   ASSERT_EQ(java.exit_code, 0) << java.err;
   EXPECT_EQ(java.out.find("unknown="), std::string::npos) << "lcm-spy would not know a type";
+  EXPECT_EQ(java.out, expected);
+}
+
+// Vouched for (the trailer of every datum vouched for after the encoding, docs/security.md), every
+// type still decodes in Java, as lcm-spy finds and decodes it, to the same fields: the trailer is
+// read past, not into the message.
+TEST(JavaDecode, VouchedMessagesDecodeToTheSameFields) {
+  std::array<uint8_t, auth::LabKey::kSize> key{};
+  key.fill(7);
+  auth::DataGuard guard(auth::credentials_from_lab_key(auth::LabKey(key), "sg-predictor"));
+  const std::string dir = make_temp_dir();
+  std::vector<std::string> argv = {"java", "-cp", SG_JAVA_CLASSPATH, "LcmDump"};
+  std::string expected;
+  int n = 0;
+  for_each_message_type([&]<class T>() {
+    const T message = make_sample<T>(SampleKind::kTypical);
+    std::vector<uint8_t> bytes = encode_message(message);
+    const size_t plain = bytes.size();
+    guard.vouch("PROCESS_STATUS", bytes);  // a trailer with 12 tags: the longest there is
+    EXPECT_GT(bytes.size(), plain + 12 * 16);
+    argv.push_back(write_message(dir + "/" + std::to_string(n++) + ".bin", bytes));
+    expected += dump(message) + "\n";
+  });
+  const ProcessResult java = run(argv, std::chrono::seconds(120));
+  ASSERT_EQ(java.exit_code, 0) << java.err;
   EXPECT_EQ(java.out, expected);
 }
 
