@@ -46,8 +46,9 @@ class LineReader {
     const std::string h = word("a key of 64 hex characters");
     std::array<uint8_t, 32> bytes{};
     std::size_t decoded = 0;
-    if (h.size() != 64 || sodium_hex2bin(bytes.data(), bytes.size(), h.data(), h.size(), nullptr,
-                                         &decoded, nullptr) != 0 ||
+    if (h.size() != 64 ||
+        sodium_hex2bin(bytes.data(), bytes.size(), h.data(), h.size(), nullptr, &decoded,
+                       nullptr) != 0 ||
         decoded != bytes.size())
       fail("a key is 64 hex characters");
     return bytes;
@@ -100,8 +101,8 @@ std::string format_credentials(const Credentials& c, const std::string& comment)
   for (const Peer& p : c.send)
     out += "send " + p.name + " " + hex(p.key.bytes().data(), 32) + " " + join(p.channels) + "\n";
   for (const Peer& p : c.receive)
-    out += "receive " + p.name + " " + hex(p.key.bytes().data(), 32) + " " + join(p.channels) +
-           "\n";
+    out +=
+        "receive " + p.name + " " + hex(p.key.bytes().data(), 32) + " " + join(p.channels) + "\n";
   return out;
 }
 
@@ -161,8 +162,8 @@ Credentials load_key_file(const std::string& path, const std::string& identity) 
   }
   sodium_memzero(text.data(), text.size());
   if (c.identity != identity)
-    throw LabKeyError("credentials " + path + ": these are " + c.identity + "'s, not " +
-                      identity + "'s");
+    throw LabKeyError("credentials " + path + ": these are " + c.identity + "'s, not " + identity +
+                      "'s");
   return c;
 }
 

@@ -7,9 +7,9 @@
 ///     # comment lines
 ///     stereograsp-credentials 1
 ///     identity sg-vision
-///     command-key <64 hex>                          (only for processes that send or obey commands)
-///     send sg-predictor <64 hex> OBJECT_POSITION    (K(identity -> reader), the channels it covers)
-///     receive sg-camera-sim <64 hex> CAMERA_LEFT,CAMERA_RIGHT
+///     command-key <64 hex>                          (only for processes that send or obey
+///     commands) send sg-predictor <64 hex> OBJECT_POSITION    (K(identity -> reader), the channels
+///     it covers) receive sg-camera-sim <64 hex> CAMERA_LEFT,CAMERA_RIGHT
 ///
 /// Every program's --key takes either this or the lab key itself (64 hex characters: every pair
 /// derived, for a bench on one host), and load_key_file() tells them apart.

@@ -31,7 +31,8 @@ void hash_name(crypto_generichash_state& state, const std::string& name) {
 
 void hash_be(crypto_generichash_state& state, uint64_t v, std::size_t bytes) {
   unsigned char b[8];
-  for (std::size_t i = 0; i < bytes; ++i) b[i] = static_cast<unsigned char>(v >> (8 * (bytes - 1 - i)));
+  for (std::size_t i = 0; i < bytes; ++i)
+    b[i] = static_cast<unsigned char>(v >> (8 * (bytes - 1 - i)));
   crypto_generichash_update(&state, b, bytes);
 }
 
@@ -39,7 +40,6 @@ void hash_be(crypto_generichash_state& state, uint64_t v, std::size_t bytes) {
 std::string stream_key(const std::string& channel, const VouchTrailer& t) {
   return t.sender + '\n' + std::to_string(t.instance) + '\n' + channel;
 }
-
 
 uint32_t random_instance() {
   ensure_sodium();
@@ -52,8 +52,8 @@ uint32_t random_instance() {
 
 const std::vector<std::string>& known_identities() {
   static const std::vector<std::string> names = {
-      "sg-camera-sim", "sg-c550-sim", "sg-vision",   "sg-predictor", "sg-grasp", "sg-grasp-ctl",
-      "sg-arm-driver", "sg-arm-ctl",  "sg-calibrate", "sg-viewer",   "sg-lab",   "sg-bus-check"};
+      "sg-camera-sim", "sg-c550-sim", "sg-vision",    "sg-predictor", "sg-grasp", "sg-grasp-ctl",
+      "sg-arm-driver", "sg-arm-ctl",  "sg-calibrate", "sg-viewer",    "sg-lab",   "sg-bus-check"};
   return names;
 }
 
@@ -104,14 +104,16 @@ bool is_command_channel(const std::string& channel) {
 Credentials credentials_from_lab_key(const LabKey& lab, const std::string& identity,
                                      const ChannelRights& rights) {
   if (!valid_vouch_name(identity))
-    throw std::invalid_argument("'" + identity + "' cannot vouch: a name is 1-32 letters, "
+    throw std::invalid_argument("'" + identity +
+                                "' cannot vouch: a name is 1-32 letters, "
                                 "digits or . _ @ : -");
   Credentials c;
   c.identity = identity;
   for (const ChannelRight& right : rights) {
     if (contains(right.publishers, identity)) {
       for (const std::string& reader : right.readers)
-        peer_named(c.send, reader, pair_key(lab, identity, reader)).channels.push_back(right.channel);
+        peer_named(c.send, reader, pair_key(lab, identity, reader))
+            .channels.push_back(right.channel);
     }
     if (contains(right.readers, identity)) {
       for (const std::string& publisher : right.publishers)
@@ -203,7 +205,8 @@ GuardResult DataGuard::judge(GuardVerdict verdict, std::string sender, std::stri
 GuardResult DataGuard::check(const std::string& channel, const uint8_t* data, std::size_t size,
                              int64_t now_utime) {
   const TrailerParse p = parse_vouch_trailer(data, size);
-  if (p.kind == TrailerParse::kNone) return judge(GuardVerdict::kUnsigned, "", "no vouching trailer");
+  if (p.kind == TrailerParse::kNone)
+    return judge(GuardVerdict::kUnsigned, "", "no vouching trailer");
   if (p.kind == TrailerParse::kMalformed) return judge(GuardVerdict::kMalformed, "", p.why);
   const VouchTrailer& t = p.trailer;
   const Peer* sender = nullptr;
@@ -220,7 +223,8 @@ GuardResult DataGuard::check(const std::string& channel, const uint8_t* data, st
                  "'" + t.sender + "' vouched for " + std::to_string(t.tags.size()) +
                      " readers, not for " + credentials_.identity);
   std::array<uint8_t, 32> k = one_time_key(sender->key, channel, t);
-  const bool good = crypto_onetimeauth_verify(mine->tag.data(), data, p.payload_size, k.data()) == 0;
+  const bool good =
+      crypto_onetimeauth_verify(mine->tag.data(), data, p.payload_size, k.data()) == 0;
   sodium_memzero(k.data(), k.size());
   if (!good) return judge(GuardVerdict::kBadTag, t.sender, "bad tag from '" + t.sender + "'");
   GuardResult r = check_counter(channel, t, now_utime);

@@ -30,7 +30,8 @@
 /// for every pair (one host, a bench); from `sg-lab`'s credential files, only its own.
 ///
 ///     const sg::auth::Credentials me =
-///         sg::auth::credentials_from_lab_key(key, "sg-predictor", sg::auth::default_channel_rights());
+///         sg::auth::credentials_from_lab_key(key, "sg-predictor",
+///         sg::auth::default_channel_rights());
 ///     bus.set_guard(std::make_shared<sg::auth::DataGuard>(me));
 ///     bus.publish("OBJECT_TRAJECTORY", t);     // vouched for sg-grasp and sg-viewer
 ///     // sg-grasp's bus, likewise guarded, hands its handler only what sg-predictor vouched for

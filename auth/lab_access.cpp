@@ -16,8 +16,7 @@ void add_key_options(CLI::App& app, KeyOptions& options) {
       "its messages, checks what it hears and signs its commands (default: $SG_LAB_KEY, else "
       "~/.config/stereograsp/lab.key; make one with sg-keygen)");
   CLI::Option* insecure = app.add_flag(
-      "--insecure-no-key",
-      options.insecure,
+      "--insecure-no-key", options.insecure,
       "run without a lab key: vouch for nothing, sign nothing, and believe and obey whatever "
       "arrives (anyone on the network can then steer the arm)");
   key->excludes(insecure);

@@ -73,7 +73,8 @@ void write_all(int fd, const std::string& text, const std::string& path) {
 void create_exclusive(const std::string& path, const std::string& text) {
   Fd f{::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600)};
   if (f.fd < 0) {
-    if (errno == EEXIST) fail(path, "already exists; not overwritten (sg-keygen --force replaces it)");
+    if (errno == EEXIST)
+      fail(path, "already exists; not overwritten (sg-keygen --force replaces it)");
     fail(path, "cannot create: " + errno_text());
   }
   if (::fchmod(f.fd, 0600) != 0) fail(path, "cannot chmod 600: " + errno_text());

@@ -154,9 +154,9 @@ void run(const RunSettings& rs, const std::vector<std::array<image_t, 2>>& frame
   if (variant.vouched)  // the frames come as sg-camera-sim's
     bus.set_guard(std::make_shared<sg::auth::VouchingPublisher>(
         sg::auth::credentials_from_lab_key(sg::auth::LabKey::load(rs.key), "sg-camera-sim")));
-  const std::vector<std::string> key =
-      variant.vouched ? std::vector<std::string>{"--key", rs.key}
-                      : std::vector<std::string>{"--insecure-no-key"};
+  const std::vector<std::string> key = variant.vouched
+                                           ? std::vector<std::string>{"--key", rs.key}
+                                           : std::vector<std::string>{"--insecure-no-key"};
   bool vision_up = false, predictor_up = false;
   bus.subscribe<stereograsp::process_status_t>("PROCESS_STATUS", [&](const auto& m, const auto&) {
     vision_up |= m.process == "sg-vision", predictor_up |= m.process == "sg-predictor";
@@ -183,8 +183,8 @@ void run(const RunSettings& rs, const std::vector<std::array<image_t, 2>>& frame
   if (!variant.busy_wait_ms.empty())
     vision_args.insert(vision_args.end(), {"--busy-wait-ms", variant.busy_wait_ms});
   vision_args.insert(vision_args.end(), key.begin(), key.end());
-  std::vector<std::string> predictor_args = {"--config", dir + "/predictor.yaml", "--lcm-url", url,
-                                             "--log-level", "error"};
+  std::vector<std::string> predictor_args = {"--config", dir + "/predictor.yaml", "--lcm-url",
+                                             url,        "--log-level",           "error"};
   predictor_args.insert(predictor_args.end(), key.begin(), key.end());
   Program vision("sg-vision", vision_args, dir + "/vision.out");
   Program predictor("sg-predictor", predictor_args, dir + "/predictor.out");

@@ -150,7 +150,8 @@ int main(int argc, char** argv) {
   const std::vector<uint8_t> left = encode(pair[0]), right = encode(pair[1]);
 
   const Percentiles t_base = encode_and_decode(n, forecast());
-  const Percentiles t_vouch = vouch_and_check(n, "OBJECT_TRAJECTORY", t, "sg-predictor", "sg-grasp");
+  const Percentiles t_vouch =
+      vouch_and_check(n, "OBJECT_TRAJECTORY", t, "sg-predictor", "sg-grasp");
   const Percentiles s_base = encode_and_decode(n, status());
   const Percentiles s_vouch = vouch_and_check(n, "PROCESS_STATUS", s, "sg-predictor", "sg-grasp");
   const int images = std::max(100, n / 20);

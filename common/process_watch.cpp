@@ -158,8 +158,8 @@ std::vector<ProcessWatch::HostOffset> ProcessWatch::host_offsets(
 std::string format_processes(const ProcessWatch& watch, int64_t now) {
   std::string out;
   char line[512];
-  std::snprintf(line, sizeof line, "%-28s %-14s %-12s %8s %8s %8s %6s %9s  %s\n", "PROCESS",
-                "HOST", "STATE", "UP", "IN/s", "OUT/s", "BAD", "UNVOUCHED", "LAST PROBLEM");
+  std::snprintf(line, sizeof line, "%-28s %-14s %-12s %8s %8s %8s %6s %9s  %s\n", "PROCESS", "HOST",
+                "STATE", "UP", "IN/s", "OUT/s", "BAD", "UNVOUCHED", "LAST PROBLEM");
   out += line;
   for (const ProcessWatch::Process& p : watch.processes()) {
     const auto& s = p.last;

@@ -64,11 +64,16 @@ struct WireLimits<stereograsp::process_status_t> {
   static constexpr int64_t kMaxString = 4096;
   /// The channels, peers and refusal rows a status lists are capped at 64 by sg::Bus.
   static std::vector<VariableArray> arrays() {
-    return {{"channel", "num_channels", 64, 1},      {"messages_in", "num_channels", 64, 1},
-            {"messages_out", "num_channels", 64, 1}, {"rate_in_hz", "num_channels", 64, 1},
-            {"rate_out_hz", "num_channels", 64, 1},  {"peer", "num_peers", 64, 1},
-            {"peer_utime", "num_peers", 64, 1},      {"peer_recv_utime", "num_peers", 64, 1},
-            {"peer_offset_us", "num_peers", 64, 1},  {"peer_offset_error_us", "num_peers", 64, 1},
+    return {{"channel", "num_channels", 64, 1},
+            {"messages_in", "num_channels", 64, 1},
+            {"messages_out", "num_channels", 64, 1},
+            {"rate_in_hz", "num_channels", 64, 1},
+            {"rate_out_hz", "num_channels", 64, 1},
+            {"peer", "num_peers", 64, 1},
+            {"peer_utime", "num_peers", 64, 1},
+            {"peer_recv_utime", "num_peers", 64, 1},
+            {"peer_offset_us", "num_peers", 64, 1},
+            {"peer_offset_error_us", "num_peers", 64, 1},
             {"unvouched_channel", "num_unvouched", 64, 1},
             {"unvouched_sender", "num_unvouched", 64, 1},
             {"unvouched_verdict", "num_unvouched", 64, 1},

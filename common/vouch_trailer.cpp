@@ -74,8 +74,8 @@ TrailerParse malformed(std::size_t size, std::string why) {
 bool valid_vouch_name(std::string_view name) {
   if (name.empty() || name.size() > kVouchMaxName) return false;
   return std::all_of(name.begin(), name.end(), [](char c) {
-    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-           c == '.' || c == '_' || c == '@' || c == ':' || c == '-';
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' ||
+           c == '_' || c == '@' || c == ':' || c == '-';
   });
 }
 

@@ -32,9 +32,9 @@
 
 namespace sg {
 
-inline constexpr std::size_t kVouchTagSize = 16;   ///< bytes of one reader's tag
-inline constexpr std::size_t kVouchMaxName = 32;   ///< bytes of a sender's or reader's name
-inline constexpr std::size_t kVouchMaxTags = 32;   ///< readers one message is vouched for
+inline constexpr std::size_t kVouchTagSize = 16;  ///< bytes of one reader's tag
+inline constexpr std::size_t kVouchMaxName = 32;  ///< bytes of a sender's or reader's name
+inline constexpr std::size_t kVouchMaxTags = 32;  ///< readers one message is vouched for
 inline constexpr char kVouchMagic[5] = "SGv1";
 
 /// One reader's proof: a tag only that reader (and the sender) can make.

@@ -12,7 +12,8 @@
 namespace {
 
 bool same(const sg::auth::Credentials& a, const sg::auth::Credentials& b) {
-  const auto peers = [](const std::vector<sg::auth::Peer>& x, const std::vector<sg::auth::Peer>& y) {
+  const auto peers = [](const std::vector<sg::auth::Peer>& x,
+                        const std::vector<sg::auth::Peer>& y) {
     if (x.size() != y.size()) return false;
     for (size_t i = 0; i < x.size(); ++i)
       if (x[i].name != y[i].name || x[i].key.bytes() != y[i].key.bytes() ||

@@ -4,14 +4,13 @@
 // the simulated serial line (system/simulated_line.hpp), recorded one operation at a time; logs
 // are written by lcm::LogFile, LCM's own writer.
 
-#include <lcm/lcm-cpp.hpp>
-
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <lcm/lcm-cpp.hpp>
 #include <string>
 #include <vector>
 
@@ -19,10 +18,10 @@
 #include "arm_driver/c550_link.hpp"
 #include "arm_driver/kinematics.hpp"
 #include "arm_driver/rapl.hpp"
+#include "auth/credentials_file.hpp"
 #include "common/bus_check.hpp"
 #include "fuzz/signed_commands.hpp"
 #include "fuzz/vouched_messages.hpp"
-#include "auth/credentials_file.hpp"
 #include "predictor/offline_training.hpp"
 #include "sim/c550_controller.hpp"
 #include "sim/c550_emulator.hpp"
@@ -37,7 +36,8 @@ namespace {
 void save(const fs::path& file, const Bytes& bytes) {
   fs::create_directories(file.parent_path());
   std::ofstream out(file, std::ios::binary);
-  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  out.write(reinterpret_cast<const char*>(bytes.data()),
+            static_cast<std::streamsize>(bytes.size()));
   std::printf("%s (%zu bytes)\n", file.c_str(), bytes.size());
 }
 
@@ -105,10 +105,12 @@ void link_session(const fs::path& out) {
   const auto tail_after_echo = [](const Bytes& bytes, size_t echoed) {
     return Bytes(bytes.begin() + static_cast<long>(std::min(echoed, bytes.size())), bytes.end());
   };
-  save(out / "rapl" / "w2_reply", tail_after_echo(record("read_joints", 2, [&] { link.read_joints(); }), 2));
+  save(out / "rapl" / "w2_reply",
+       tail_after_echo(record("read_joints", 2, [&] { link.read_joints(); }), 2));
   const std::string ma = sg::arm::rapl::move_joints({0.1, -0.2, 0.3, 0, 0.5, 0});
   save(out / "rapl" / "ma_reply",
-       tail_after_echo(record("move", 3, [&] { link.command(ma, std::chrono::seconds(3)); }), ma.size()));
+       tail_after_echo(record("move", 3, [&] { link.command(ma, std::chrono::seconds(3)); }),
+                       ma.size()));
   record("point", 3, [&] {
     link.command(sg::arm::rapl::point("P1", {0.4, 0.1, 0.3}, {0, 3.1, 0}), std::chrono::seconds(1));
   });
@@ -116,7 +118,8 @@ void link_session(const fs::path& out) {
        tail_after_echo(record("read_location", 4, [&] { link.read_location("P1"); }), 7));
   const std::string bad = sg::arm::rapl::move_joints({3.1, 0, 0, 0, 0, 0});  // past joint 1's limit
   save(out / "rapl" / "refused_reply",
-       tail_after_echo(record("refused", 3, [&] { link.command(bad, std::chrono::seconds(3)); }), bad.size()));
+       tail_after_echo(record("refused", 3, [&] { link.command(bad, std::chrono::seconds(3)); }),
+                       bad.size()));
   record("close_session", 7, [&] { link.close_session(); });
   record("read_memory", 5, [&] { link.read_memory(sg::arm::aci::kMemPointerList, 0, 0, 64); });
   record("write_memory", 6, [&] {

@@ -45,9 +45,9 @@ const Vouched& vouched_set(const sg::auth::Credentials& grasp) {
     }
     const auto bad = sg::fuzz::not_allowed_and_wrong_key();
     sg::auth::DataGuard fresh(grasp, {}, sg::system_clock(), 9);
-    SG_FUZZ_CHECK(fresh.check(sg::fuzz::kVouchChannels[0], bad[0].bytes.data(),
-                              bad[0].bytes.size(), sg::fuzz::kNow)
-                          .verdict == sg::GuardVerdict::kNotAllowed &&
+    SG_FUZZ_CHECK(fresh.check(sg::fuzz::kVouchChannels[0], bad[0].bytes.data(), bad[0].bytes.size(),
+                              sg::fuzz::kNow)
+                              .verdict == sg::GuardVerdict::kNotAllowed &&
                       fresh.check(sg::fuzz::kVouchChannels[0], bad[1].bytes.data(),
                                   bad[1].bytes.size(), sg::fuzz::kNow)
                               .verdict == sg::GuardVerdict::kBadTag,
@@ -62,9 +62,9 @@ void check_trailer(const std::vector<uint8_t>& bytes, const sg::GuardResult& r) 
   const sg::TrailerParse p = sg::parse_vouch_trailer(bytes.data(), bytes.size());
   SG_FUZZ_CHECK((p.kind == sg::TrailerParse::kNone) == (r.verdict == sg::GuardVerdict::kUnsigned),
                 "verdict %s for a parse of kind %d", sg::to_string(r.verdict), p.kind);
-  SG_FUZZ_CHECK((p.kind == sg::TrailerParse::kMalformed) ==
-                    (r.verdict == sg::GuardVerdict::kMalformed),
-                "verdict %s for a parse of kind %d", sg::to_string(r.verdict), p.kind);
+  SG_FUZZ_CHECK(
+      (p.kind == sg::TrailerParse::kMalformed) == (r.verdict == sg::GuardVerdict::kMalformed),
+      "verdict %s for a parse of kind %d", sg::to_string(r.verdict), p.kind);
   SG_FUZZ_CHECK(p.payload_size <= bytes.size(), "payload %zu of %zu bytes", p.payload_size,
                 bytes.size());
   if (p.kind != sg::TrailerParse::kFound) return;
@@ -110,8 +110,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
                   "replay accepted: counter %lld after %lld",
                   static_cast<long long>(p.trailer.counter), static_cast<long long>(seen->second));
     SG_FUZZ_CHECK(p.trailer.counter >= now - 30'000'000 && p.trailer.counter <= now + 30'000'000,
-                  "stale accepted: counter %lld at %lld",
-                  static_cast<long long>(p.trailer.counter), static_cast<long long>(now));
+                  "stale accepted: counter %lld at %lld", static_cast<long long>(p.trailer.counter),
+                  static_cast<long long>(now));
     last[stream] = p.trailer.counter;
   }
   int64_t counted = 0;

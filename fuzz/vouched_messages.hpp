@@ -59,8 +59,8 @@ inline std::vector<VouchedMessage> vouched_messages() {
 inline std::vector<VouchedMessage> not_allowed_and_wrong_key() {
   FixedClock clock;
   std::vector<VouchedMessage> out;
-  for (const auto& [who, key] : {std::pair{"sg-vision", fuzz_key()},
-                                 std::pair{"sg-predictor", other_key()}}) {
+  for (const auto& [who, key] :
+       {std::pair{"sg-vision", fuzz_key()}, std::pair{"sg-predictor", other_key()}}) {
     auth::DataGuard g(auth::credentials_from_lab_key(key, who), {}, clock, 3);
     VouchedMessage m = vouched_messages()[0];
     m.bytes.resize(vouched_payload_size(m.bytes.data(), m.bytes.size()));

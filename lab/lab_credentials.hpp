@@ -7,8 +7,9 @@
 /// never holds the lab key, only the keys of the processes it runs: a thief of the cameras' host
 /// can speak as sg-camera-sim and sg-vision and as nobody else, and cannot sign a command.
 ///
-///     const auto files = sg::lab::stage_credentials(lab, key, session, stage);   // process -> path
-///     shell->copy_all(stage, {files.at("vision")}, 30);                          // to its host
+///     const auto files = sg::lab::stage_credentials(lab, key, session, stage);   // process ->
+///     path shell->copy_all(stage, {files.at("vision")}, 30);                          // to its
+///     host
 
 #include <map>
 #include <string>

@@ -11,11 +11,11 @@
 #include <sstream>
 #include <thread>
 
+#include "auth/data_auth.hpp"
 #include "common/bus.hpp"
 #include "common/clock.hpp"
 #include "common/process_watch.hpp"
 #include "common/shutdown.hpp"
-#include "auth/data_auth.hpp"
 #include "lab/host_shell.hpp"
 #include "lab/lab_credentials.hpp"
 
@@ -61,8 +61,9 @@ class LabSession::Listener {
  public:
   Listener(const std::string& url, bool take_part, const std::optional<auth::LabKey>& key)
       : bus(url) {
-    if (key) bus.set_guard(std::make_shared<auth::DataGuard>(
-                 auth::credentials_from_lab_key(*key, "sg-lab")));
+    if (key)
+      bus.set_guard(
+          std::make_shared<auth::DataGuard>(auth::credentials_from_lab_key(*key, "sg-lab")));
     bus.subscribe<stereograsp::process_status_t>(
         "PROCESS_STATUS", [this](const stereograsp::process_status_t& s, const ReceiveInfo& info) {
           watch.receive(s, info.recv_utime);
@@ -352,8 +353,8 @@ void LabSession::distribute_credentials(const std::string& skip) {
   for (const ProcessSpec& p : lab_.processes)
     if (paths.count(p.name) != 0) by_host[p.host].push_back(paths.at(p.name));
   for (const auto& [host, files] : by_host) {
-    const CommandResult r = make_shell(lab_.host(host), project_)->copy_all(stage, files,
-                                                                            kShellTimeout);
+    const CommandResult r =
+        make_shell(lab_.host(host), project_)->copy_all(stage, files, kShellTimeout);
     if (!r.ok()) throw LabError("copying credentials to " + host + ": " + r.describe());
   }
   std::error_code ec;
@@ -466,7 +467,8 @@ void LabSession::revoke(const std::string& name) {
   make_shell(lab_.host(p->host), project_)
       ->run("rm -f " + shell_quote(credentials_path(session_, name)), kShellTimeout);
   out_ << "sg-lab: " << name << " revoked: stopped, its credentials deleted on " << p->host
-       << "; the lab's keys are now of generation " << next << "\n" << std::flush;
+       << "; the lab's keys are now of generation " << next << "\n"
+       << std::flush;
   for (const ProcessSpec& q : lab_.processes) {
     const bool running = std::any_of(started_.begin(), started_.end(),
                                      [&](const StartedProcess& s) { return s.name == q.name; });
@@ -494,9 +496,9 @@ int LabSession::status(double listen_s) {
   l.watch.check(now);
   bool healthy = true;
   char line[512];
-  std::snprintf(line, sizeof line, "%-12s %-10s %-16s %8s %-12s %8s %8s %8s %5s %9s  %s\n",
-                "NAME", "HOST", "PROGRAM", "PID", "STATE", "UP", "IN/s", "OUT/s", "BAD",
-                "UNVOUCHED", "LAST PROBLEM");
+  std::snprintf(line, sizeof line, "%-12s %-10s %-16s %8s %-12s %8s %8s %8s %5s %9s  %s\n", "NAME",
+                "HOST", "PROGRAM", "PID", "STATE", "UP", "IN/s", "OUT/s", "BAD", "UNVOUCHED",
+                "LAST PROBLEM");
   out_ << "lab '" << lab_.lab << "', session " << session_ << "\n" << line;
   const std::set<std::string> up = running();
   for (const StartedProcess& s : started_) {

@@ -50,9 +50,9 @@ struct LogRecord {
   int64_t event_number = 0;
   const uint8_t* data = nullptr;
   int size = 0;  ///< the LCM encoding's bytes: a vouching trailer (docs/security.md) taken off
-  int64_t offset = 0;  ///< byte offset of the event's header in the file
-  int recorded_size = 0;    ///< the bytes as recorded, trailer included
-  std::string vouched_by;   ///< the sender its trailer names ("" when it carries none)
+  int64_t offset = 0;      ///< byte offset of the event's header in the file
+  int recorded_size = 0;   ///< the bytes as recorded, trailer included
+  std::string vouched_by;  ///< the sender its trailer names ("" when it carries none)
 };
 
 /// Something wrong with the file itself (not with a message inside it).

@@ -356,8 +356,8 @@ void md_problems(std::ostream& o, const SessionSummary& s) {
   }
   for (const ProcessSummary& p : s.processes.processes) {
     for (const std::string& r : p.refusals)
-      o << "- " << md_cell(p.name) << " refused messages nobody it believes vouched for: "
-        << md_cell(r) << "\n";
+      o << "- " << md_cell(p.name)
+        << " refused messages nobody it believes vouched for: " << md_cell(r) << "\n";
     any = any || !p.refusals.empty();
   }
   if (!any) o << "None.\n";

@@ -15,9 +15,9 @@ namespace {
 /// A process's refusals of unvouched messages, a line a row of its PROCESS_STATUS.
 std::vector<std::string> refusal_lines(const stereograsp::process_status_t& st) {
   std::vector<std::string> lines;
-  const auto rows = std::min<size_t>(
-      {static_cast<size_t>(std::max(st.num_unvouched, 0)), st.unvouched_channel.size(),
-       st.unvouched_sender.size(), st.unvouched_verdict.size(), st.unvouched_count.size()});
+  const auto rows = std::min<size_t>({static_cast<size_t>(std::max(st.num_unvouched, 0)),
+                                      st.unvouched_channel.size(), st.unvouched_sender.size(),
+                                      st.unvouched_verdict.size(), st.unvouched_count.size()});
   for (size_t i = 0; i < rows; ++i) {
     const std::string from =
         st.unvouched_sender[i].empty() ? "" : " from '" + st.unvouched_sender[i] + "'";
@@ -713,8 +713,8 @@ struct SessionStats::Impl {
       const auto& st = p.last;
       s.processes.push_back(
           {p.name, st.host, t(p.first_heard), t(p.last_heard), state_name(st.state),
-           st.decode_errors + st.refused_inputs + st.handler_errors, st.last_problem,
-           st.vouched_as, st.unvouched_inputs, refusal_lines(st)});
+           st.decode_errors + st.refused_inputs + st.handler_errors, st.last_problem, st.vouched_as,
+           st.unvouched_inputs, refusal_lines(st)});
     }
     const ProcessWatch::Process* grasp_process = watch.find("sg-grasp");
     const auto hosts = watch.hosts();

@@ -40,7 +40,7 @@ int run(const std::string& url, const sg::predictor::PredictorSettings& settings
         const sg::auth::LabAccess& lab) {
   sg::install_shutdown_handlers();
   sg::Bus bus(url);
-  lab.guard(bus);  // believes OBJECT_POSITION only from sg-vision
+  lab.guard(bus);                // believes OBJECT_POSITION only from sg-vision
   bus.announce("sg-predictor");  // PROCESS_STATUS: the refusals counted with note_refused()
   sg::Clock& clock = sg::system_clock();
   sg::predictor::PredictorNode node(settings, clock);
@@ -130,8 +130,7 @@ int main(int argc, char** argv) {
     if (*train_cmd) return train(input, channel, settings.params, out);
     if (!settings.coefficients.empty())
       sg::predictor::read_coefficients(settings.coefficients, settings.params);
-    return sg::auth::with_lab_access(app.get_name(), key_options, [&](auto& lab) {
-      return run(common.lcm_url, settings, lab);
-    });
+    return sg::auth::with_lab_access(app.get_name(), key_options,
+                                     [&](auto& lab) { return run(common.lcm_url, settings, lab); });
   });
 }

@@ -11,8 +11,8 @@
 
 #include <algorithm>
 
-#include "auth/lab_access.hpp"
 #include "arm_driver/kinematics.hpp"
+#include "auth/lab_access.hpp"
 #include "common/bus.hpp"
 #include "common/program.hpp"
 #include "common/shutdown.hpp"

@@ -52,9 +52,8 @@ TEST(BusGuard, VouchedMessageReachesEverySubscriptionOnce) {
   bus.subscribe<stereograsp::point3_t>("OBJECT_POSITION", [&](const auto& p, const auto& info) {
     first += p.utime == 7 && info.size == point(7).getEncodedSize();
   });
-  bus.subscribe<stereograsp::point3_t>("OBJECT_.*", [&](const auto& p, const auto&) {
-    second += p.utime == 7;
-  });
+  bus.subscribe<stereograsp::point3_t>("OBJECT_.*",
+                                       [&](const auto& p, const auto&) { second += p.utime == 7; });
   bus.publish("OBJECT_POSITION", point(7));
   while (bus.handle(10ms)) {
   }

@@ -225,7 +225,8 @@ TEST(DataAuth, StreamTableIsBounded) {
 // BLAKE2b and Poly1305 over the bytes the header documents.
 TEST(DataAuth, KeysAndTagsAreTheDocumentedBlake2b) {
   const LabKey lab = key_of(9);
-  std::vector<uint8_t> label = {'s', 'g', '-', 'p', 'a', 'i', 'r', '-', 'v', '1', 1, 'a', 2, 'b', 'c'};
+  std::vector<uint8_t> label = {'s', 'g', '-', 'p', 'a', 'i', 'r', '-',
+                                'v', '1', 1,   'a', 2,   'b', 'c'};
   std::array<uint8_t, 32> expected{};
   crypto_generichash(expected.data(), 32, label.data(), label.size(), lab.bytes().data(), 32);
   EXPECT_EQ(pair_key(lab, "a", "bc").bytes(), expected);
@@ -233,9 +234,9 @@ TEST(DataAuth, KeysAndTagsAreTheDocumentedBlake2b) {
 
   const PairKey pair = pair_key(lab, "a", "bc");
   const VouchTrailer t{"s", 0x01020304, 0x05, {}};
-  const std::vector<uint8_t> k_input = {'s', 'g', '-', 'o', 't', 'k', '-', 'v', '1', 2, 'C', 'H',
-                                        1,   's', 1,   2,   3,   4,   0,   0,   0,   0,   0,   0,
-                                        0,   5};
+  const std::vector<uint8_t> k_input = {'s', 'g', '-', 'o', 't', 'k', '-', 'v', '1',
+                                        2,   'C', 'H', 1,   's', 1,   2,   3,   4,
+                                        0,   0,   0,   0,   0,   0,   0,   5};
   std::array<uint8_t, 32> k{};
   crypto_generichash(k.data(), 32, k_input.data(), k_input.size(), pair.bytes().data(), 32);
   EXPECT_EQ(one_time_key(pair, "CH", t), k);
@@ -255,10 +256,9 @@ TEST(DataAuth, DefaultRightsGiveEachProcessItsPeers) {
     for (const std::string& c : p.channels)
       if (c != "PROCESS_STATUS") believes.push_back(p.name + " " + c);
   std::sort(believes.begin(), believes.end());
-  EXPECT_EQ(believes, (std::vector<std::string>{"sg-arm-driver ARM_STATUS",
-                                                "sg-grasp-ctl GRASP_COMMAND",
-                                                "sg-predictor OBJECT_TRAJECTORY",
-                                                "sg-vision OBJECT_POSITION"}));
+  EXPECT_EQ(believes, (std::vector<std::string>{
+                          "sg-arm-driver ARM_STATUS", "sg-grasp-ctl GRASP_COMMAND",
+                          "sg-predictor OBJECT_TRAJECTORY", "sg-vision OBJECT_POSITION"}));
   size_t status_readers = 0;
   for (const Peer& p : grasp.send)
     status_readers += std::count(p.channels.begin(), p.channels.end(), "PROCESS_STATUS");

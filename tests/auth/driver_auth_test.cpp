@@ -46,7 +46,8 @@ int moves_logged(const std::string& path) {
 }
 
 arm_cmd_t move(int64_t sequence, const std::string& sender) {
-  arm_cmd_t c = tool_down_move(sequence, 0.45, 0.10, 0.30, std::atan2(0.10, 0.45) + std::numbers::pi);
+  arm_cmd_t c =
+      tool_down_move(sequence, 0.45, 0.10, 0.30, std::atan2(0.10, 0.45) + std::numbers::pi);
   c.utime = now_utime();
   c.sender = sender;
   return c;
@@ -77,10 +78,11 @@ TEST(DriverAuth, RefusesUnsignedAndForgedExecutesSigned) {
   });
   sim_arm_state_t truth{};
   int truths = 0;
-  bus.subscribe<sim_arm_state_t>("SIM_ARM_STATE", [&](const sim_arm_state_t& s, const ReceiveInfo&) {
-    truth = s;
-    ++truths;
-  });
+  bus.subscribe<sim_arm_state_t>("SIM_ARM_STATE",
+                                 [&](const sim_arm_state_t& s, const ReceiveInfo&) {
+                                   truth = s;
+                                   ++truths;
+                                 });
   Child sim({program("sg-c550-sim"), "--lcm-url", url, "--link", device, "--log-commands", log,
              "--delay-min", "0.3", "--delay-max", "0.4", "--speed", "100"});
   ASSERT_TRUE(eventually([&] { return std::filesystem::exists(device); }, 30s, "the pty"));
@@ -92,9 +94,9 @@ TEST(DriverAuth, RefusesUnsignedAndForgedExecutesSigned) {
 
   // Not vouched for on the bus: refused before the driver's handler, counted on PROCESS_STATUS.
   rogue.publish("ARM_COMMAND", move(9, "rogue"));
-  ASSERT_TRUE(eventually(bus, [&] {
-    return unvouched(driver_status, "ARM_COMMAND", "unsigned") >= 1;
-  }, 10s, "the unvouched command counted"));
+  ASSERT_TRUE(eventually(
+      bus, [&] { return unvouched(driver_status, "ARM_COMMAND", "unsigned") >= 1; }, 10s,
+      "the unvouched command counted"));
   EXPECT_EQ(status.last_rejected_sequence, -1);  // it never reached the driver
   EXPECT_EQ(status.last_received_sequence, -1);
 
@@ -105,18 +107,21 @@ TEST(DriverAuth, RefusesUnsignedAndForgedExecutesSigned) {
   eight.encode(vouched.data(), 0, static_cast<int>(vouched.size()));
   bench->inner().vouch("ARM_COMMAND", vouched);
   rogue.publish_raw("ARM_COMMAND", vouched.data(), static_cast<int>(vouched.size()));
-  ASSERT_TRUE(eventually(bus, [&] { return status.last_rejected_sequence == 8; }, 10s,
-                         "the vouched but unsigned command refused by the command check"));
+  ASSERT_TRUE(eventually(
+      bus, [&] { return status.last_rejected_sequence == 8; }, 10s,
+      "the vouched but unsigned command refused by the command check"));
   rogue.publish_raw("ARM_COMMAND", vouched.data(), static_cast<int>(vouched.size()));
-  ASSERT_TRUE(eventually(bus, [&] {
-    return unvouched(driver_status, "ARM_COMMAND", "replayed") >= 1;
-  }, 10s, "the datagram replayed refused on the bus"));
+  ASSERT_TRUE(eventually(
+      bus, [&] { return unvouched(driver_status, "ARM_COMMAND", "replayed") >= 1; }, 10s,
+      "the datagram replayed refused on the bus"));
 
   // Vouched for, but unsigned: refused by the command check, named, nothing received.
   bus.publish("ARM_COMMAND", move(10, "rogue"));
-  ASSERT_TRUE(eventually(bus, [&] { return status.last_rejected_sequence == 10; }, 10s,
-                         "the unsigned command refused"));
-  EXPECT_EQ(status.rejection_reason, "unauthenticated: unsigned command from 'rogue' (no auth_tag)");
+  ASSERT_TRUE(eventually(
+      bus, [&] { return status.last_rejected_sequence == 10; }, 10s,
+      "the unsigned command refused"));
+  EXPECT_EQ(status.rejection_reason,
+            "unauthenticated: unsigned command from 'rogue' (no auth_tag)");
   EXPECT_EQ(status.last_received_sequence, -1);
   EXPECT_EQ(status.commander, "");  // an unauthenticated command takes no lease
 
@@ -134,7 +139,8 @@ TEST(DriverAuth, RefusesUnsignedAndForgedExecutesSigned) {
       bus, [&] { return status.last_rejected_sequence == std::numeric_limits<int64_t>::max(); },
       10s, "the forged command refused"));
   EXPECT_EQ(status.rejection_reason.rfind("unauthenticated: bad auth_tag on a command from "
-                                          "'sg-grasp'", 0),
+                                          "'sg-grasp'",
+                                          0),
             0u)
       << status.rejection_reason;
   EXPECT_EQ(status.last_received_sequence, -1);
@@ -151,9 +157,13 @@ TEST(DriverAuth, RefusesUnsignedAndForgedExecutesSigned) {
   arm_cmd_t real = move(11, "");
   signer.sign("ARM_COMMAND", real);
   bus.publish("ARM_COMMAND", real);
-  ASSERT_TRUE(eventually(bus, [&] {
-    return status.last_executed_sequence == 11 && status.state == arm_status_t::STATE_IDLE;
-  }, 20s, "the signed command executed")) << status.rejection_reason;
+  ASSERT_TRUE(eventually(
+      bus,
+      [&] {
+        return status.last_executed_sequence == 11 && status.state == arm_status_t::STATE_IDLE;
+      },
+      20s, "the signed command executed"))
+      << status.rejection_reason;
   EXPECT_LT(std::hypot(status.tool_position[0] - 0.45, status.tool_position[1] - 0.10,
                        status.tool_position[2] - 0.30),
             1e-3);
@@ -162,8 +172,8 @@ TEST(DriverAuth, RefusesUnsignedAndForgedExecutesSigned) {
 
   // The same signed bytes again: a replay, refused before the validator.
   bus.publish("ARM_COMMAND", real);
-  ASSERT_TRUE(eventually(bus, [&] { return status.last_rejected_sequence == 11; }, 10s,
-                         "the replay refused"));
+  ASSERT_TRUE(eventually(
+      bus, [&] { return status.last_rejected_sequence == 11; }, 10s, "the replay refused"));
   EXPECT_EQ(status.rejection_reason.rfind("unauthenticated: replayed: auth_counter", 0), 0u)
       << status.rejection_reason;
   EXPECT_EQ(moves_logged(log), 1);
@@ -186,8 +196,8 @@ TEST(DriverAuth, NoKeyExitsTwoUnlessInsecure) {
                        "/absent.key: no such file; make one with `sg-keygen " + dir +
                        "/absent.key` and copy it to every lab machine (mode 0600), give --key "
                        "PATH, or run with --insecure-no-key\n");
-  const ProcessResult insecure = run({program("sg-arm-driver"), "--lcm-url", "memq://",
-                                      "--device", dir + "/none", "--insecure-no-key"},
+  const ProcessResult insecure = run({program("sg-arm-driver"), "--lcm-url", "memq://", "--device",
+                                      dir + "/none", "--insecure-no-key"},
                                      10s);
   EXPECT_NE(insecure.err.find("INSECURE: running without a lab key"), std::string::npos)
       << insecure.err;

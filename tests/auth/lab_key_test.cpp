@@ -149,8 +149,10 @@ TEST(LabAccess, NoKeyExitsTwo) {
   const std::string err = testing::internal::GetCapturedStderr();
   EXPECT_EQ(rc, kExitNoKey);
   EXPECT_FALSE(ran);
-  EXPECT_NE(err.find("sg-test: error: lab key " + options.path + ": no such file; make one with "
-                     "`sg-keygen " + options.path + "`"),
+  EXPECT_NE(err.find("sg-test: error: lab key " + options.path +
+                     ": no such file; make one with "
+                     "`sg-keygen " +
+                     options.path + "`"),
             std::string::npos)
       << err;
   EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1);
@@ -189,8 +191,8 @@ TEST(LabAccess, WithAKeySignsAndChecks) {
     EXPECT_EQ(lab.command_key()->bytes(), command_key(LabKey::load(options.path)).bytes());
     stereograsp::grasp_command_t unsigned_command{};
     unsigned_command.sender = "sg-test";
-    EXPECT_EQ(lab.refusal("GRASP_COMMAND", unsigned_command, 1'000'000).rfind(
-                  "unauthenticated: unsigned", 0),
+    EXPECT_EQ(lab.refusal("GRASP_COMMAND", unsigned_command, 1'000'000)
+                  .rfind("unauthenticated: unsigned", 0),
               0u);
     stereograsp::grasp_command_t c{};
     lab.sign("GRASP_COMMAND", c);
@@ -213,7 +215,8 @@ TEST(LabAccess, WithoutCommandRightsNoCommandIsSignedOrObeyed) {
     EXPECT_FALSE(lab.command_key().has_value());
     stereograsp::grasp_command_t c{};
     EXPECT_THROW(lab.sign("GRASP_COMMAND", c), std::runtime_error);
-    EXPECT_EQ(lab.refusal("GRASP_COMMAND", c, 1), "unauthenticated: sg-predictor holds no command key");
+    EXPECT_EQ(lab.refusal("GRASP_COMMAND", c, 1),
+              "unauthenticated: sg-predictor holds no command key");
     return 0;
   });
   EXPECT_EQ(rc, 0);

@@ -45,9 +45,8 @@ TEST(VouchTrailer, LayoutCountedByHand) {
   t.counter = 0x0102030405060708;
   std::vector<uint8_t> bytes;
   append_vouch_trailer(bytes, t);
-  const std::vector<uint8_t> expected = {2,    'a',  'b',  0x11, 0x22, 0x33, 0x44, 1,   2,
-                                         3,    4,    5,    6,    7,    8,    0,    0,   22,
-                                         'S',  'G',  'v',  '1'};
+  const std::vector<uint8_t> expected = {2, 'a', 'b', 0x11, 0x22, 0x33, 0x44, 1,   2,   3,   4,
+                                         5, 6,   7,   8,    0,    0,    22,   'S', 'G', 'v', '1'};
   EXPECT_EQ(bytes, expected);
 }
 

@@ -315,8 +315,8 @@ class OtherCommander {
       : thread_([url, name](std::stop_token stop) {
           Bus bus(url);
           bus.set_guard(vouching_as("sg-arm-ctl"));
-          auth::CommandSigner signer(auth::command_key(auth::LabKey::load(auth::default_key_path())),
-                                     name);
+          auth::CommandSigner signer(
+              auth::command_key(auth::LabKey::load(auth::default_key_path())), name);
           arm_cmd_t c = move_to(1, 0.40, 0.0, 0.35);
           while (!stop.stop_requested()) {
             signer.sign("ARM_COMMAND", c);
@@ -351,9 +351,9 @@ TEST(ArmProcesses, ArmCtlHonoursTheLeaseAndTakesItOver) {
   EXPECT_EQ(rig.status().commander, "holder@bench:1");
   EXPECT_GT(tool_error(rig.status(), 0.5, 0.1, 0.3), 0.05);  // not moved there
 
-  const ProcessResult taken = run({program("sg-arm-ctl"), "--lcm-url", rig.url(), "--take-over",
-                                   "move", "0.5", "0.1", "0.3"},
-                                  30s);
+  const ProcessResult taken = run(
+      {program("sg-arm-ctl"), "--lcm-url", rig.url(), "--take-over", "move", "0.5", "0.1", "0.3"},
+      30s);
   EXPECT_EQ(taken.exit_code, 0) << taken.out << taken.err;
   EXPECT_NE(taken.out.find("executed"), std::string::npos) << taken.out;
   EXPECT_TRUE(rig.wait_until([&] { return tool_error(rig.status(), 0.5, 0.1, 0.3) < 1e-3; }, 10s));

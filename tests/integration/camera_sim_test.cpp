@@ -115,8 +115,8 @@ std::vector<stereograsp::point3_t> truth_while_holding(Bus& bus, int port) {
   Bus watcher(test_url(port));
   watcher.subscribe<stereograsp::point3_t>("GROUND_TRUTH",
                                            [&](const auto& m, const auto&) { truth.push_back(m); });
-  Child sim({program("sg-camera-sim"), "--rate", "10", "--frames", "40", "--lcm-url",
-             test_url(port)});
+  Child sim(
+      {program("sg-camera-sim"), "--rate", "10", "--frames", "40", "--lcm-url", test_url(port)});
   stereograsp::sim_arm_state_t arm{};
   arm.tool_position[0] = 0.40, arm.tool_position[1] = 0.10, arm.tool_position[2] = 0.30;
   arm.tool_orientation[1] = M_PI;
@@ -157,8 +157,7 @@ TEST(CameraSim, IgnoresSimArmStateNobodyVouchedFor) {
     const std::vector<stereograsp::point3_t> truth = truth_while_holding(rogue, kPort);
     ASSERT_GE(truth.size(), 30u) << as_vision;
     for (const auto& p : truth) {
-      ASSERT_GT(std::hypot(p.position[0] - 0.40, p.position[1] - 0.10, p.position[2] - 0.30),
-                0.05)
+      ASSERT_GT(std::hypot(p.position[0] - 0.40, p.position[1] - 0.10, p.position[2] - 0.30), 0.05)
           << "the forged arm state moved the ball (as sg-vision: " << as_vision << ")";
     }
   }

@@ -13,8 +13,8 @@
 #include <signal.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <deque>
 #include <filesystem>
 #include <optional>
@@ -43,10 +43,11 @@ struct Truth {
   explicit Truth(Bus& bus) {
     bus.subscribe<stereograsp::point3_t>("GROUND_TRUTH",
                                          [this](const auto& m, const auto&) { ball = m; });
-    bus.subscribe<stereograsp::sim_arm_state_t>("SIM_ARM_STATE", [this](const auto& m, const auto&) {
-      arm = m;
-      ++arm_states;
-    });
+    bus.subscribe<stereograsp::sim_arm_state_t>("SIM_ARM_STATE",
+                                                [this](const auto& m, const auto&) {
+                                                  arm = m;
+                                                  ++arm_states;
+                                                });
     bus.subscribe<stereograsp::grasp_status_t>("GRASP_STATUS",
                                                [this](const auto& m, const auto&) { grasp = m; });
     bus.subscribe<stereograsp::process_status_t>(
@@ -62,9 +63,7 @@ struct Truth {
     return std::hypot(arm.tool_position[0] - ball.position[0],
                       arm.tool_position[1] - ball.position[1] - kSide);
   }
-  bool tracking() const {
-    return grasp.activity == stereograsp::grasp_status_t::ACTIVITY_TRACKING;
-  }
+  bool tracking() const { return grasp.activity == stereograsp::grasp_status_t::ACTIVITY_TRACKING; }
   stereograsp::point3_t ball{};
   stereograsp::sim_arm_state_t arm{};
   int arm_states = 0;
@@ -99,7 +98,10 @@ class Intruder {
     if (images_) {
       for (const char* c : {"CAMERA_LEFT", "CAMERA_RIGHT"}) {
         bus_.subscribe<stereograsp::image_t>(
-            c, [this, c](const auto& m, const auto&) { heard_.push_back({c, m}); },
+            c,
+            [this, c](const auto& m, const auto&) {
+              heard_.push_back({c, m});
+            },
             kQueueFrames);
       }
     }
@@ -155,12 +157,12 @@ struct Loop {
   Loop(const std::string& url, const std::string& dir, int port,
        const std::vector<std::string>& extra) {
     write_circle(dir + "/circle.csv");
-    EXPECT_EQ(run({program("sg-predictor"), "train", dir + "/circle.csv", "--out",
-                   dir + "/coeffs.yaml"})
-                  .exit_code,
-              0);
-    EXPECT_EQ(run({program("sg-camera-sim"), "--snapshot", dir + "/pair.png",
-                   "--calibration-out", dir + "/cams.yaml", "--log-level", "warn"})
+    EXPECT_EQ(
+        run({program("sg-predictor"), "train", dir + "/circle.csv", "--out", dir + "/coeffs.yaml"})
+            .exit_code,
+        0);
+    EXPECT_EQ(run({program("sg-camera-sim"), "--snapshot", dir + "/pair.png", "--calibration-out",
+                   dir + "/cams.yaml", "--log-level", "warn"})
                   .exit_code,
               0);
     const auto start = [&](std::vector<std::string> args) {
@@ -217,15 +219,17 @@ std::pair<double, double> under_attack(Bus& bus, Truth& truth, std::vector<Intru
 /// Starts tracking and waits until the arm follows the real ball (horizontally within 3 cm).
 ::testing::AssertionResult start_tracking(Bus& bus, Truth& truth, const std::string& url,
                                           const std::vector<std::string>& extra) {
-  if (auto r = eventually(bus, [&] { return truth.arm_states > 0 && truth.ball.utime > 0; }, 60s,
-                          "the simulated arm and ball");
+  if (auto r = eventually(
+          bus, [&] { return truth.arm_states > 0 && truth.ball.utime > 0; }, 60s,
+          "the simulated arm and ball");
       !r)
     return r;
   std::vector<std::string> track = {program("sg-grasp-ctl"), "--lcm-url", url, "track"};
   track.insert(track.end(), extra.begin(), extra.end());
   for (int attempt = 0; attempt < 5; ++attempt) {  // refused until sg-grasp has a forecast
     if (run(track, 20s).exit_code == 0) break;
-    wait_until(bus, [] { return false; }, 2s);
+    wait_until(
+        bus, [] { return false; }, 2s);
   }
   return eventually(
       bus, [&] { return truth.tracking() && truth.tool_to_ball() < 0.03; }, 90s,
@@ -247,9 +251,10 @@ TEST(ForgedData, TheArmFollowsOnlyWhatTheLabVouchedFor) {
 
   Intruder stranger(url, "", true), cameras_host(url, "sg-camera-sim", true);
   const auto [during, during_forgery] = under_attack(bus, truth, {&stranger, &cameras_host}, 15);
-  std::printf("tool to the real ball (median, horizontal): %.1f mm before the forgery, %.1f mm "
-              "during it; to the made-up ball %.1f mm during it\n",
-              before * 1e3, during * 1e3, during_forgery * 1e3);
+  std::printf(
+      "tool to the real ball (median, horizontal): %.1f mm before the forgery, %.1f mm "
+      "during it; to the made-up ball %.1f mm during it\n",
+      before * 1e3, during * 1e3, during_forgery * 1e3);
   EXPECT_GT(stranger.rounds(), 200);
   EXPECT_GT(stranger.images_sent(), 20);
   EXPECT_LT(during, 0.03) << "before the forgery " << before;
@@ -275,7 +280,8 @@ TEST(ForgedData, TheArmFollowsOnlyWhatTheLabVouchedFor) {
   }
   const ProcessResult r = ctl.wait(5s);
   EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
-  wait_until(bus, [&] { return truth.arm.holding_object != 0; }, 10s);
+  wait_until(
+      bus, [&] { return truth.arm.holding_object != 0; }, 10s);
   EXPECT_TRUE(truth.arm.holding_object) << "the simulated gripper does not hold the ball";
 }
 

@@ -168,8 +168,8 @@ std::string outputs(std::vector<Subject>& subjects) {
 /// OBJECT_TRAJECTORY too: a forged SIM_ARM_STATE with holding_object set once made sg-camera-sim
 /// carry the ball to the tool and drop it there, out of view; it now believes SIM_ARM_STATE only
 /// from sg-c550-sim, so the ball stays in view and the forecasts go on.
-constexpr const char* kOutputs[] = {"ARM_STATUS", "SIM_ARM_STATE", "OBJECT_POSITION",
-                                    "GROUND_TRUTH", "GRASP_STATUS", "OBJECT_TRAJECTORY"};
+constexpr const char* kOutputs[] = {"ARM_STATUS",   "SIM_ARM_STATE", "OBJECT_POSITION",
+                                    "GROUND_TRUTH", "GRASP_STATUS",  "OBJECT_TRAJECTORY"};
 
 /// The messages a process refused before decoding: nobody the lab allows vouched for them, or
 /// they did not decode as their type.
@@ -177,7 +177,8 @@ int64_t refused_before_decoding(const stereograsp::process_status_t& s) {
   return s.decode_errors + s.unvouched_inputs;
 }
 
-/// What held before the attack: who reports PROCESS_STATUS (and what it refused before decoding), the arm.
+/// What held before the attack: who reports PROCESS_STATUS (and what it refused before decoding),
+/// the arm.
 struct AtRest {
   std::map<std::string, int64_t> decode_errors;  // refused before decoding, by process
   stereograsp::sim_arm_state_t arm{};

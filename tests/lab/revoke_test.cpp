@@ -34,8 +34,8 @@ std::string write_lab(const std::string& dir, const std::string& project) {
   fs::copy_file(std::string(SG_SOURCE_DIR) + "/config/stereograsp.yaml",
                 project + "/config/stereograsp.yaml");
   fs::create_directory_symlink(fs::path(SG_BIN_DIR).parent_path(), project + "/build");
-  EXPECT_EQ(run({program("sg-camera-sim"), "--calibration-out", dir + "/cams.yaml", "--frames",
-                 "1", "--fast", "--lcm-url", test_url(kPort + 1)})
+  EXPECT_EQ(run({program("sg-camera-sim"), "--calibration-out", dir + "/cams.yaml", "--frames", "1",
+                 "--fast", "--lcm-url", test_url(kPort + 1)})
                 .exit_code,
             0);
   std::ofstream(dir + "/lab.yaml")
@@ -75,11 +75,12 @@ stereograsp::trajectory_t forecast() {
 /// Publishes 20 forecasts vouched for with `credentials` over 1 s, reading `bus` meanwhile.
 void forge(Bus& bus, const std::string& credentials) {
   Bus thief(test_url(kPort));
-  thief.set_guard(std::make_shared<auth::VouchingPublisher>(
-      auth::load_key_file(credentials, "sg-predictor")));
+  thief.set_guard(
+      std::make_shared<auth::VouchingPublisher>(auth::load_key_file(credentials, "sg-predictor")));
   for (int i = 0; i < 20; ++i) {
     thief.publish("OBJECT_TRAJECTORY", forecast());
-    wait_until(bus, [] { return false; }, 50ms);
+    wait_until(
+        bus, [] { return false; }, 50ms);
   }
 }
 
@@ -107,7 +108,8 @@ TEST(Revoke, TheRevokedCredentialsAreRefused) {
 
   // Before: sg-grasp believes what the predictor's credentials vouch for.
   forge(bus, stolen);
-  ASSERT_TRUE(eventually(bus, [&] { return statuses.of.count("sg-grasp") != 0; }, 10s, "sg-grasp"));
+  ASSERT_TRUE(eventually(
+      bus, [&] { return statuses.of.count("sg-grasp") != 0; }, 10s, "sg-grasp"));
   EXPECT_EQ(unvouched(statuses.of["sg-grasp"], "OBJECT_TRAJECTORY", "bad tag"), 0);
 
   const ProcessResult revoked = lab_cmd({"revoke", "predictor"});
@@ -123,10 +125,10 @@ TEST(Revoke, TheRevokedCredentialsAreRefused) {
       << unvouched(statuses.of["sg-grasp"], "OBJECT_TRAJECTORY", "bad tag");
   // The restarted sg-vision believes the restarted cameras: positions keep coming.
   int64_t positions = 0;
-  bus.subscribe<stereograsp::point3_t>("OBJECT_POSITION", [&](const auto& p, const auto&) {
-    positions += p.utime > after;
-  });
-  EXPECT_TRUE(eventually(bus, [&] { return positions >= 3; }, 15s, "positions after the revoke"));
+  bus.subscribe<stereograsp::point3_t>(
+      "OBJECT_POSITION", [&](const auto& p, const auto&) { positions += p.utime > after; });
+  EXPECT_TRUE(eventually(
+      bus, [&] { return positions >= 3; }, 15s, "positions after the revoke"));
   EXPECT_EQ(lab_cmd({"down"}).exit_code, 0);
 }
 

@@ -242,7 +242,7 @@ TEST(ReportLive, RecordedSessionFromTheRealPredictor) {
 
   Bus bus(test_url(7922));
   bus.set_guard(vouching_as("sg-vision"));  // the predictor believes positions only from vision
-  int64_t newest_source = 0;  // the newest forecast's measurement time
+  int64_t newest_source = 0;                // the newest forecast's measurement time
   int positions_heard = 0, forecasts_heard = 0;
   bus.subscribe<stereograsp::trajectory_t>(
       "OBJECT_TRAJECTORY", [&](const stereograsp::trajectory_t& t, const ReceiveInfo&) {
