@@ -5,8 +5,10 @@
 // committed seeds are forecasts and an ARM_STATUS vouched for with that key, one vouched for by a
 // process not allowed on its channel, one under another key, a replay, and unvouched bytes.
 // Asserts, beyond never crashing and check never throwing:
-//  - a message is accepted only if it is, to the byte and on its channel, one of the vouched
-//    messages (libFuzzer cannot forge a Poly1305 tag, so anything else accepted is a hole);
+//  - a message is accepted only if its channel, its LCM encoding, its sender, instance and
+//    counter and the tag for sg-grasp are those of one of the vouched messages (libFuzzer cannot
+//    forge a Poly1305 tag, so anything else accepted is a hole); the other readers' tags are
+//    theirs to check, and changing one makes no message believed that was not vouched for;
 //  - accepted messages of one (sender, instance, channel) have strictly increasing counters,
 //    each within 30 s of the reader's clock; the payload size is what the trailer leaves;
 //  - kUnsigned is exactly "no magic at the end", kMalformed exactly a parse that fails;
@@ -14,6 +16,7 @@
 //  - the guard's counts add up to the messages it was given.
 
 #include <algorithm>
+#include <array>
 #include <map>
 #include <set>
 #include <string>
@@ -28,7 +31,25 @@
 
 namespace {
 
-using Vouched = std::set<std::pair<int, std::vector<uint8_t>>>;  // (channel, bytes)
+/// What sg-grasp's tag vouches for in a message on `channel`: the encoding, the sender, its run,
+/// the counter, and the tag itself.
+using Vouching = std::tuple<int, std::vector<uint8_t>, std::string, uint32_t, int64_t,
+                            std::array<uint8_t, sg::kVouchTagSize>>;
+using Vouched = std::set<Vouching>;
+
+/// `bytes`' Vouching as sg-grasp reads it (a zero tag when it has none).
+Vouching vouching_of(int channel, const std::vector<uint8_t>& bytes) {
+  const sg::TrailerParse p = sg::parse_vouch_trailer(bytes.data(), bytes.size());
+  std::array<uint8_t, sg::kVouchTagSize> tag{};
+  for (const sg::VouchTag& t : p.trailer.tags)
+    if (t.reader == "sg-grasp") tag = t.tag;
+  return {channel,
+          std::vector<uint8_t>(bytes.begin(), bytes.begin() + static_cast<long>(p.payload_size)),
+          p.trailer.sender,
+          p.trailer.instance,
+          p.trailer.counter,
+          tag};
+}
 
 /// The vouched messages; first checks the check is not vacuous: a fresh guard accepts each, and
 /// refuses the not-allowed and other-key ones as such.
@@ -41,7 +62,7 @@ const Vouched& vouched_set(const sg::auth::Credentials& grasp) {
                                             m.bytes.size(), sg::fuzz::kNow);
       SG_FUZZ_CHECK(r.accepted(), "a vouched seed is %s: %s", sg::to_string(r.verdict),
                     r.reason.c_str());
-      s.insert({m.channel, m.bytes});
+      s.insert(vouching_of(m.channel, m.bytes));
     }
     const auto bad = sg::fuzz::not_allowed_and_wrong_key();
     sg::auth::DataGuard fresh(grasp, {}, sg::system_clock(), 9);
@@ -98,7 +119,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     SG_FUZZ_CHECK(r.accepted() == r.reason.empty(), "reason '%s' with %s", r.reason.c_str(),
                   sg::to_string(r.verdict));
     if (!r.accepted()) continue;
-    SG_FUZZ_CHECK(vouched.count({channel, bytes}) == 1,
+    SG_FUZZ_CHECK(vouched.count(vouching_of(channel, bytes)) == 1,
                   "accepted %zu bytes on '%s' from '%s' that nobody vouched for", bytes.size(),
                   sg::fuzz::kVouchChannels[channel].c_str(), r.sender.c_str());
     const sg::TrailerParse p = sg::parse_vouch_trailer(bytes.data(), bytes.size());
