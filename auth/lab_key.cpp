@@ -59,6 +59,19 @@ void check_mode(int fd, const std::string& path) {
   }
 }
 
+/// Up to `limit` bytes of the secret file at `path`, once it is known to be a regular file that
+/// only its owner may read (check_mode).
+std::string read_checked(const std::string& path, std::size_t limit) {
+  ensure_sodium();
+  Fd f{::open(path.c_str(), O_RDONLY | O_CLOEXEC)};
+  if (f.fd < 0) {
+    if (errno == ENOENT) fail(path, "no such file");
+    fail(path, "cannot open: " + errno_text());
+  }
+  check_mode(f.fd, path);
+  return read_some(f.fd, limit, path);
+}
+
 void write_all(int fd, const std::string& text, const std::string& path) {
   std::size_t done = 0;
   while (done < text.size()) {
@@ -98,14 +111,7 @@ LabKey& LabKey::operator=(const LabKey& other) {
 LabKey::~LabKey() { sodium_memzero(bytes_.data(), bytes_.size()); }
 
 std::string read_secret_file(const std::string& path, std::size_t limit) {
-  ensure_sodium();
-  Fd f{::open(path.c_str(), O_RDONLY | O_CLOEXEC)};
-  if (f.fd < 0) {
-    if (errno == ENOENT) fail(path, "no such file");
-    fail(path, "cannot open: " + errno_text());
-  }
-  check_mode(f.fd, path);
-  std::string text = read_some(f.fd, limit + 1, path);
+  std::string text = read_checked(path, limit + 1);
   if (text.size() > limit) {
     sodium_memzero(text.data(), text.size());
     fail(path, "more than " + std::to_string(limit) + " bytes");
@@ -159,15 +165,8 @@ LabKey generation_key(const LabKey& lab, uint32_t generation) {
 }
 
 LabKey LabKey::load(const std::string& path) {
-  ensure_sodium();
-  Fd f{::open(path.c_str(), O_RDONLY | O_CLOEXEC)};
-  if (f.fd < 0) {
-    if (errno == ENOENT) fail(path, "no such file");
-    fail(path, "cannot open: " + errno_text());
-  }
-  check_mode(f.fd, path);
   constexpr std::size_t kLimit = kHexSize + 8;  // enough to tell "too long"
-  std::string text = read_some(f.fd, kLimit, path);
+  std::string text = read_checked(path, kLimit);
   const bool cut = text.size() == kLimit;
   if (!text.empty() && text.back() == '\n') text.pop_back();
   if (text.size() != kHexSize) {

@@ -352,7 +352,9 @@ bool Bus::handle(std::chrono::microseconds timeout) {
 
 bool Bus::handle_lcm(int timeout_ms) {
   ++dispatch_;  // LCM dispatches one message a handle, to each subscription it matches
+  in_lcm_handle_ = true;
   const int status = lcm_->handleTimeout(timeout_ms);
+  in_lcm_handle_ = false;
   if (status > 0) return true;
   if (status == 0) return false;
   if (url_.rfind("file://", 0) == 0) {  // LCM 1.3.1 returns -1 at the end of a log
@@ -390,12 +392,14 @@ bool Bus::admit(const std::string& channel, const uint8_t* data, size_t size, si
     payload = vouched_payload_size(data, size);
     return true;
   }
-  if (admitted_.dispatch == dispatch_ && admitted_.channel == channel) {  // the same message
+  const bool same = in_lcm_handle_ && admitted_.dispatch == dispatch_ && admitted_.data == data &&
+                    admitted_.size == size && admitted_.channel == channel;
+  if (same) {  // the message LCM is handing to its next subscription
     payload = admitted_.payload;
     return admitted_.accepted;
   }
   const GuardResult r = guard_->check(channel, data, size, now_utime());
-  admitted_ = {dispatch_, channel, r.accepted(), r.payload_size};
+  admitted_ = {dispatch_, channel, data, size, r.accepted(), r.payload_size};
   if (!r.accepted()) report_unvouched(channel, r);
   payload = r.payload_size;
   return r.accepted();

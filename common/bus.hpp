@@ -294,11 +294,16 @@ class Bus {
   std::shared_ptr<MessageGuard> guard_;
   /// LCM hands one message to every subscription it matches, one after another within one
   /// handle: the guard judges it once (a second check would call it a replay), and the others
-  /// get that verdict. dispatch_ counts the handles and direct messages.
+  /// get that verdict: the same handle (dispatch_ counts them), channel, bytes and size. Only
+  /// within Bus::handle (in_lcm_handle_): an `lcm().handle()` of a caller's own gets no shared
+  /// verdict, so a second subscription may refuse (never believe) what the first accepted.
   uint64_t dispatch_ = 0;
+  bool in_lcm_handle_ = false;
   struct Admitted {
     uint64_t dispatch = ~uint64_t{0};
     std::string channel;
+    const uint8_t* data = nullptr;
+    size_t size = 0;
     bool accepted = false;
     size_t payload = 0;
   } admitted_;

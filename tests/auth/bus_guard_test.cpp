@@ -63,6 +63,43 @@ TEST(BusGuard, VouchedMessageReachesEverySubscriptionOnce) {
   EXPECT_EQ(bus.decode_errors(), 0u);
 }
 
+// Two messages handed to the same subscriptions one after the other are judged each on its own:
+// a forged one right after a vouched one, of the same size and trailer, reaches no handler.
+TEST(BusGuard, EachMessageIsJudgedOnItsOwn) {
+  Bus bus("memq://");
+  bus.set_guard(guard_of("a"));
+  int first = 0, second = 0;
+  bus.subscribe<stereograsp::point3_t>("OBJECT_POSITION",
+                                       [&](const auto& p, const auto&) { first += p.utime; });
+  bus.subscribe<stereograsp::point3_t>("OBJECT_.*",
+                                       [&](const auto& p, const auto&) { second += p.utime; });
+  std::vector<uint8_t> vouched = bytes_of(point(1));
+  guard_of("a")->vouch("OBJECT_POSITION", vouched);
+  std::vector<uint8_t> forged = bytes_of(point(100));  // the same size, the same trailer
+  forged.insert(forged.end(), vouched.begin() + static_cast<long>(forged.size()), vouched.end());
+  ASSERT_EQ(forged.size(), vouched.size());
+  bus.lcm().publish("OBJECT_POSITION", vouched.data(), vouched.size());
+  bus.lcm().publish("OBJECT_POSITION", forged.data(), forged.size());
+  while (bus.handle(10ms)) {
+  }
+  EXPECT_EQ(first, 1);
+  EXPECT_EQ(second, 1);
+  EXPECT_EQ(bus.unvouched().at({"OBJECT_POSITION", "a", GuardVerdict::kBadTag}), 1u);
+  // The same through a caller's own lcm().handle(), which shares no verdict: the forged one still
+  // reaches no handler (the vouched one reaches the first subscription; the second, judging it
+  // again, calls it a replay: it refuses, it never believes).
+  std::vector<uint8_t> again = bytes_of(point(2));
+  guard_of("a")->vouch("OBJECT_POSITION", again);
+  bus.lcm().publish("OBJECT_POSITION", again.data(), again.size());
+  bus.lcm().publish("OBJECT_POSITION", forged.data(), forged.size());
+  bus.lcm().handle();
+  bus.lcm().handle();
+  EXPECT_EQ(first, 3);
+  EXPECT_EQ(second, 1);
+  EXPECT_EQ(bus.unvouched().at({"OBJECT_POSITION", "a", GuardVerdict::kBadTag}), 3u);  // twice
+  EXPECT_EQ(bus.unvouched().at({"OBJECT_POSITION", "a", GuardVerdict::kReplayed}), 1u);
+}
+
 // Unsigned bytes and bytes vouched for by a process not allowed on the channel never reach the
 // handler; each is counted under its channel, claimed sender and verdict, and PROCESS_STATUS
 // carries the rows and who the bus vouches as.
