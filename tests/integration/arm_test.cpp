@@ -245,6 +245,50 @@ TEST(ArmProcesses, MoveGripperCycleAndRejection) {
   EXPECT_EQ(starting_with(logged_commands(rig.command_log()), "MA").size(), before);
 }
 
+/// Closes the gripper (command `sequence`) while `truth` publishes the ball at the tool,
+/// (0.45, 0.10, 0.30), at 20 Hz; whether sg-c550-sim then says it holds the ball.
+bool close_on_a_ball_from(ArmRig& rig, Bus& truth, int64_t sequence) {
+  stereograsp::point3_t ball{};
+  ball.visible = 1;
+  ball.position[0] = 0.45, ball.position[1] = 0.10, ball.position[2] = 0.30;
+  const auto publish = [&] {
+    ball.utime = now_utime();
+    truth.publish("GROUND_TRUTH", ball);
+  };
+  for (int i = 0; i < 10; ++i) {  // half a second of the ball there before the close
+    publish();
+    rig.wait_until([] { return false; }, 50ms);
+  }
+  rig.command(gripper(sequence, arm_cmd_t::GRIPPER_CLOSE));
+  for (int i = 0; i < 200 && rig.status().last_executed_sequence != sequence; ++i) {
+    publish();
+    rig.wait_until([&] { return rig.status().last_executed_sequence == sequence; }, 50ms);
+  }
+  rig.wait_until([] { return false; }, 300ms);  // a SIM_ARM_STATE sent since
+  return rig.truth().holding_object != 0;
+}
+
+// GROUND_TRUTH is believed only from sg-camera-sim: a ball published at the open gripper by a
+// host without credentials, or vouched for as sg-vision, is not grasped by the close; the same
+// ball vouched for as sg-camera-sim is.
+TEST(ArmProcesses, OnlyTheCamerasTruthPutsABallInTheGripper) {
+  ASSERT_TRUE(multicast_available(7919));
+  ArmRig rig(7919, {});
+  ASSERT_TRUE(rig.wait_connected());
+  rig.command(move_to(1, 0.45, 0.10, 0.30));
+  ASSERT_TRUE(rig.wait_executed(1)) << rig.status().error << rig.status().rejection_reason;
+  Bus stranger(rig.url()), vision(rig.url()), cameras(rig.url());
+  vision.set_guard(vouching_as("sg-vision"));
+  cameras.set_guard(vouching_as("sg-camera-sim"));
+  EXPECT_FALSE(close_on_a_ball_from(rig, stranger, 2)) << "an unvouched ball was grasped";
+  rig.command(gripper(3, arm_cmd_t::GRIPPER_OPEN));
+  ASSERT_TRUE(rig.wait_executed(3));
+  EXPECT_FALSE(close_on_a_ball_from(rig, vision, 4)) << "sg-vision's ball was grasped";
+  rig.command(gripper(5, arm_cmd_t::GRIPPER_OPEN));
+  ASSERT_TRUE(rig.wait_executed(5));
+  EXPECT_TRUE(close_on_a_ball_from(rig, cameras, 6)) << "the cameras' ball was not grasped";
+}
+
 // A burst of 100 commands while one interaction is in flight: the newest wins, no backlog, and no
 // command reaches the controller twice.
 TEST(ArmProcesses, LatestWinsUnderABurst) {
