@@ -151,6 +151,37 @@ TEST(BusGuard, UnguardedBusReadsVouchedMessages) {
   EXPECT_EQ(bus.process_status(1).vouched_as, "");
 }
 
+// A PROCESS_STATUS nobody the lab allows vouched for never reaches the clock exchange: the clock
+// offsets a process measures (and sg-grasp corrects its timing by) come only from vouched peers.
+TEST(BusGuard, ForgedStatusesNeverReachTheClockExchange) {
+  Bus bus("memq://");
+  bus.set_guard(guard_of("a"));
+  bus.announce("a");
+  stereograsp::process_status_t forged{};
+  forged.utime = now_utime() + 5'000'000;  // a host 5 s ahead, it would claim
+  forged.process = "a";
+  forged.host = "elsewhere";
+  forged.pid = 4242;
+  std::vector<uint8_t> unsigned_bytes = bytes_of(forged), stranger_bytes = bytes_of(forged);
+  guard_of("b")->vouch("PROCESS_STATUS", stranger_bytes);
+  std::vector<uint8_t> vouched = bytes_of(forged);
+  guard_of("a")->vouch("PROCESS_STATUS", vouched);
+  bus.lcm().publish("PROCESS_STATUS", unsigned_bytes.data(), unsigned_bytes.size());
+  bus.lcm().publish("PROCESS_STATUS", stranger_bytes.data(), stranger_bytes.size());
+  while (bus.handle(10ms)) {
+  }
+  ASSERT_NE(bus.clock_sync(), nullptr);
+  EXPECT_TRUE(bus.clock_sync()->offsets().empty()) << "a forged peer was heard";
+  EXPECT_EQ(bus.unvouched().at({"PROCESS_STATUS", "", GuardVerdict::kUnsigned}), 1u);
+  EXPECT_EQ(bus.unvouched().at({"PROCESS_STATUS", "b", GuardVerdict::kNotAllowed}), 1u);
+  // The same status vouched for by an allowed publisher is heard (the check is what kept it out).
+  bus.lcm().publish("PROCESS_STATUS", vouched.data(), vouched.size());
+  while (bus.handle(10ms)) {
+  }
+  ASSERT_EQ(bus.clock_sync()->offsets().size(), 1u);
+  EXPECT_EQ(bus.clock_sync()->offsets()[0].host, "elsewhere");
+}
+
 // The refusal table is bounded: 100 made-up senders give at most 32 rows and an "(other)" row
 // that sums the rest.
 TEST(BusGuard, RefusalRowsAreBounded) {
