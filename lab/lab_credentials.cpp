@@ -36,7 +36,7 @@ std::map<std::string, std::string> stage_credentials(const LabFile& lab, const a
     if (identity.empty() || names_its_key(p)) continue;
     const std::string path = credentials_path(session, p.name);
     auth::write_credentials_file((std::filesystem::path(stage) / path).string(),
-                                 auth::credentials_from_lab_key(key, identity),
+                                 auth::credentials_from_lab_key(key, identity, lab.rights),
                                  "lab '" + lab.lab + "', session " + session + ", process '" +
                                      p.name + "' on " + p.host + ": " + identity);
     paths[p.name] = path;

@@ -9,6 +9,7 @@
 #include <set>
 #include <sstream>
 
+#include "auth/credentials_file.hpp"
 #include "common/config.hpp"
 
 namespace sg::lab {
@@ -209,6 +210,32 @@ void check_names(const LabFile& lab, const YAML::Node& root, const std::string& 
                   "recorder: host '" + lab.recorder.host + "' is not in hosts (" + all_hosts + ")");
 }
 
+/// One entry of `rights:`: {channel: NAME, publishers: [...], readers: [...]}, over the table.
+void read_right(const YAML::Node& node, const std::string& file, auth::ChannelRights& rights) {
+  Reader r(node, file, "rights");
+  auth::ChannelRight right;
+  r.text("channel", right.channel);
+  if (!auth::valid_channel_name(right.channel))
+    throw r.error(r.get("channel"), "rights: '" + right.channel + "' is not a channel name");
+  const std::string what = "rights of " + right.channel;
+  Reader named(node, file, what);
+  named.get("channel");
+  named.list("publishers", right.publishers);
+  named.list("readers", right.readers);
+  for (const auto* names : {&right.publishers, &right.readers})
+    for (const std::string& n : *names)
+      if (!valid_vouch_name(n))
+        throw named.error(what + ": '" + n + "' is not a program's name (sg-vision, ...)");
+  if (right.readers.size() > kVouchMaxTags) throw named.error(what + ": at most 32 readers");
+  named.done();
+  const auto same = [&](const auth::ChannelRight& x) { return x.channel == right.channel; };
+  const auto at = std::find_if(rights.begin(), rights.end(), same);
+  if (at != rights.end())
+    *at = std::move(right);
+  else
+    rights.push_back(std::move(right));
+}
+
 void read_recorder(Reader& top, LabFile& lab, const std::string& file) {
   const YAML::Node node = top.get("recorder");
   for (const HostSpec& h : lab.hosts)
@@ -291,6 +318,10 @@ LabFile parse_yaml(const std::string& text, const std::string& name) {
     throw top.error("'processes' must list at least one process");
   for (const YAML::Node& p : processes) lab.processes.push_back(read_process(p, name));
   read_recorder(top, lab, name);
+  if (const YAML::Node rights = top.get("rights")) {
+    if (!rights.IsSequence()) throw top.error(rights, "'rights' must list channels");
+    for (const YAML::Node& r : rights) read_right(r, name, lab.rights);
+  }
   if (const YAML::Node t = top.get("timeouts")) {
     Reader r(t, name, "timeouts");
     r.number("ready", lab.ready_timeout, 0.5, 600);

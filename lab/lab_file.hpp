@@ -47,6 +47,8 @@
 #include <string>
 #include <vector>
 
+#include "auth/data_auth.hpp"
+
 namespace sg::lab {
 
 /// A lab file that cannot be used; the message names the file, line, column and what is wrong.
@@ -119,6 +121,10 @@ struct LabFile {
   std::vector<HostSpec> hosts;
   std::vector<ProcessSpec> processes;  ///< in start order
   RecorderSpec recorder;
+  /// Who may publish on which channel and who reads it (docs/security.md): the system's table
+  /// (auth::default_channel_rights) with the lab file's `rights:` entries over it, an entry
+  /// replacing the table's row of its channel or adding one. sg-lab makes credentials from it.
+  auth::ChannelRights rights = auth::default_channel_rights();
   double ready_timeout = 15;  ///< s for a process to become ready
   double stop_timeout = 5;    ///< s after SIGINT before SIGTERM, and after SIGTERM before SIGKILL
 

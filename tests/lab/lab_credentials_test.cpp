@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "auth/credentials_file.hpp"
@@ -69,6 +70,40 @@ TEST(LabCredentials, TheCameraHostCanSpeakOnlyAsItsProcesses) {
   EXPECT_EQ(grasp.check("OBJECT_TRAJECTORY", forecast.data(), forecast.size(), now_utime()).verdict,
             GuardVerdict::kNotAllowed);
   EXPECT_FALSE(auth::load_key_file(stage + "/" + files.at("cameras"), "sg-camera-sim").command_key);
+}
+
+// The lab file's `rights:` over the system's table: a new channel (a baseline predictor's) and a
+// channel's row replaced (OBJECT_POSITION read by sg-predictor alone); the credentials follow it.
+TEST(LabCredentials, TheLabFilesRightsGoIntoTheCredentials) {
+  const LabFile lab = parse_lab_file(
+      std::string(kLab) +
+          "rights:\n"
+          "  - {channel: OBJECT_TRAJECTORY_KALMAN, publishers: [sg-predictor], readers: "
+          "[sg-grasp]}\n"
+          "  - {channel: OBJECT_POSITION, publishers: [sg-vision], readers: [sg-predictor]}\n",
+      "lab.yaml");
+  const std::string stage = test::make_temp_dir();
+  const auto files = stage_credentials(lab, key(), "t-1", stage);
+  const auth::Credentials grasp = auth::load_key_file(stage + "/" + files.at("grasp"), "sg-grasp");
+  std::vector<std::string> believes;
+  for (const auth::Peer& p : grasp.receive)
+    for (const std::string& c : p.channels)
+      if (c != "PROCESS_STATUS") believes.push_back(p.name + " " + c);
+  std::sort(believes.begin(), believes.end());
+  EXPECT_EQ(believes,
+            (std::vector<std::string>{"sg-arm-driver ARM_STATUS", "sg-grasp-ctl GRASP_COMMAND",
+                                      "sg-predictor OBJECT_TRAJECTORY",
+                                      "sg-predictor OBJECT_TRAJECTORY_KALMAN"}));
+  // A bad entry is refused with its line.
+  try {
+    parse_lab_file(std::string(kLab) + "rights:\n  - {channel: X, publishers: [a b]}\n",
+                   "lab.yaml");
+    ADD_FAILURE() << "a bad publisher name was accepted";
+  } catch (const LabError& e) {
+    EXPECT_NE(std::string(e.what()).find("lab.yaml:13:5:"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'a b' is not a program's name"), std::string::npos)
+        << e.what();
+  }
 }
 
 // Which processes take a key, and which name their own.
