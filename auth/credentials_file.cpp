@@ -88,6 +88,18 @@ void add_peer(LineReader& r, std::vector<Peer>& peers, const char* kind) {
 
 }  // namespace
 
+bool same_credentials(const Credentials& a, const Credentials& b) {
+  const auto same_peers = [](const std::vector<Peer>& x, const std::vector<Peer>& y) {
+    return std::equal(x.begin(), x.end(), y.begin(), y.end(), [](const Peer& p, const Peer& q) {
+      return p.name == q.name && p.key.bytes() == q.key.bytes() && p.channels == q.channels;
+    });
+  };
+  const bool keys = a.command_key.has_value() == b.command_key.has_value() &&
+                    (!a.command_key || a.command_key->bytes() == b.command_key->bytes());
+  return a.identity == b.identity && keys && same_peers(a.send, b.send) &&
+         same_peers(a.receive, b.receive);
+}
+
 bool valid_channel_name(const std::string& name) {
   if (name.empty() || name.size() > 63) return false;
   return std::all_of(name.begin(), name.end(),

@@ -43,6 +43,9 @@ void write_credentials_file(const std::string& path, const Credentials& credenti
 /// be `identity`'s. Throws LabKeyError naming the path.
 Credentials load_key_file(const std::string& path, const std::string& identity);
 
+/// True when two credentials hold the same identity, keys and channels, peer by peer in order.
+bool same_credentials(const Credentials& a, const Credentials& b);
+
 /// True when `name` can be a channel in a credentials file: 1..63 printable bytes, no space,
 /// comma or control character.
 bool valid_channel_name(const std::string& name);

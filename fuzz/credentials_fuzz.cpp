@@ -9,25 +9,6 @@
 #include "auth/credentials_file.hpp"
 #include "fuzz/fuzz_support.hpp"
 
-namespace {
-
-bool same(const sg::auth::Credentials& a, const sg::auth::Credentials& b) {
-  const auto peers = [](const std::vector<sg::auth::Peer>& x,
-                        const std::vector<sg::auth::Peer>& y) {
-    if (x.size() != y.size()) return false;
-    for (size_t i = 0; i < x.size(); ++i)
-      if (x[i].name != y[i].name || x[i].key.bytes() != y[i].key.bytes() ||
-          x[i].channels != y[i].channels)
-        return false;
-    return true;
-  };
-  return a.identity == b.identity && a.command_key.has_value() == b.command_key.has_value() &&
-         (!a.command_key || a.command_key->bytes() == b.command_key->bytes()) &&
-         peers(a.send, b.send) && peers(a.receive, b.receive);
-}
-
-}  // namespace
-
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size > sg::auth::kMaxCredentialsFile) return 0;  // the loader refuses larger files first
   const std::string text(reinterpret_cast<const char*>(data), size);
@@ -55,6 +36,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   } catch (const sg::auth::LabKeyError& e) {
     SG_FUZZ_CHECK(false, "written credentials do not parse: %s", e.what());
   }
-  SG_FUZZ_CHECK(same(c, back), "credentials do not round trip");
+  SG_FUZZ_CHECK(sg::auth::same_credentials(c, back), "credentials do not round trip");
   return 0;
 }

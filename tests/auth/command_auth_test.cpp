@@ -8,13 +8,14 @@
 #include <sodium.h>
 
 #include <cmath>
-#include <numbers>
 #include <cstring>
 #include <limits>
+#include <numbers>
 #include <random>
 
 #include "arm_driver/arm_driver.hpp"
 #include "tests/support/arm_commands.hpp"
+#include "tests/support/manual_clock.hpp"
 
 namespace sg::auth {
 namespace {
@@ -25,18 +26,9 @@ using stereograsp::grasp_command_t;
 constexpr int kTrials = 10'000;
 constexpr int64_t kT0 = 1'780'000'000'000'000;  // µs since the epoch (2026)
 
-/// A clock that stands where the test puts it (utime() only; nothing here waits).
-class ManualClock final : public Clock {
- public:
-  int64_t at = kT0;
-  double now() override { return static_cast<double>(at) * 1e-6; }
-  int64_t utime() override { return at; }
-  bool wait_until(std::unique_lock<std::mutex>&, double, const std::function<bool()>& ready,
-                  std::stop_token) override {
-    return ready();
-  }
-  void notify() override {}
-  void sleep_until(double) override {}
+/// The test's clock, at kT0 unless moved.
+struct ManualClock : test::ManualClock {
+  ManualClock() : test::ManualClock(kT0) {}
 };
 
 LabKey key_from(uint8_t seed) {
@@ -47,7 +39,8 @@ LabKey key_from(uint8_t seed) {
 
 /// A reachable tool-down move (the driver accepts it).
 arm_cmd_t move(int64_t sequence) {
-  arm_cmd_t c = test::tool_down_move(sequence, 0.45, 0.10, 0.30, std::atan2(0.10, 0.45) + std::numbers::pi);
+  arm_cmd_t c =
+      test::tool_down_move(sequence, 0.45, 0.10, 0.30, std::atan2(0.10, 0.45) + std::numbers::pi);
   c.utime = kT0;
   return c;
 }
@@ -195,15 +188,33 @@ TEST_F(CommandAuth, FieldsChangedAfterSigningAreRefused) {
     arm_cmd_t c = move(i + 1);
     signer.sign("ARM_COMMAND", c);
     switch (i % 9) {
-      case 0: c.position[rng() % 3] += 0.01; break;
-      case 1: c.sequence = std::numeric_limits<int64_t>::max(); break;
-      case 2: c.mode = arm_cmd_t::MODE_STOP; break;
-      case 3: c.gripper = arm_cmd_t::GRIPPER_OPEN; break;
-      case 4: c.speed = 1.0; break;
-      case 5: c.sender = "sg-arm-ctl"; break;
-      case 6: c.auth_counter += 1; break;
-      case 7: c.utime += 1; break;
-      case 8: c.auth_tag[rng() % kTagSize] ^= static_cast<uint8_t>(1u << (rng() % 8)); break;
+      case 0:
+        c.position[rng() % 3] += 0.01;
+        break;
+      case 1:
+        c.sequence = std::numeric_limits<int64_t>::max();
+        break;
+      case 2:
+        c.mode = arm_cmd_t::MODE_STOP;
+        break;
+      case 3:
+        c.gripper = arm_cmd_t::GRIPPER_OPEN;
+        break;
+      case 4:
+        c.speed = 1.0;
+        break;
+      case 5:
+        c.sender = "sg-arm-ctl";
+        break;
+      case 6:
+        c.auth_counter += 1;
+        break;
+      case 7:
+        c.utime += 1;
+        break;
+      case 8:
+        c.auth_tag[rng() % kTagSize] ^= static_cast<uint8_t>(1u << (rng() % 8));
+        break;
     }
     ASSERT_EQ(verifier.verify("ARM_COMMAND", c, kT0).verdict, Verdict::kBadTag) << i % 9;
   }

@@ -21,21 +21,6 @@ LabKey key_of(uint8_t seed) {
   return LabKey(b);
 }
 
-bool same(const Credentials& a, const Credentials& b) {
-  const auto peers_equal = [](const std::vector<Peer>& x, const std::vector<Peer>& y) {
-    if (x.size() != y.size()) return false;
-    for (size_t i = 0; i < x.size(); ++i)
-      if (x[i].name != y[i].name || x[i].key.bytes() != y[i].key.bytes() ||
-          x[i].channels != y[i].channels)
-        return false;
-    return true;
-  };
-  const bool keys = a.command_key.has_value() == b.command_key.has_value() &&
-                    (!a.command_key || a.command_key->bytes() == b.command_key->bytes());
-  return a.identity == b.identity && keys && peers_equal(a.send, b.send) &&
-         peers_equal(a.receive, b.receive);
-}
-
 void write_text(const std::string& path, const std::string& text) {
   std::ofstream(path) << text;
   chmod(path.c_str(), 0600);
@@ -53,7 +38,7 @@ TEST(CredentialsFile, WrittenAndReadBackEqual) {
     ASSERT_EQ(stat(path.c_str(), &st), 0);
     EXPECT_EQ(st.st_mode & 0777, 0600u);
     const Credentials back = load_key_file(path, who);
-    EXPECT_TRUE(same(c, back)) << who;
+    EXPECT_TRUE(same_credentials(c, back)) << who;
     EXPECT_EQ(back.command_key.has_value(), std::string(who) == "sg-grasp");
   }
 }
@@ -119,8 +104,8 @@ TEST(CredentialsFile, AnotherIdentityOrAnOpenFileIsRefused) {
 TEST(CredentialsFile, TheLabKeyLoadsAsEveryPair) {
   const std::string path = test::make_temp_dir() + "/lab.key";
   write_new_key_file(path);
-  EXPECT_TRUE(same(load_key_file(path, "sg-grasp"),
-                   credentials_from_lab_key(LabKey::load(path), "sg-grasp")));
+  EXPECT_TRUE(same_credentials(load_key_file(path, "sg-grasp"),
+                               credentials_from_lab_key(LabKey::load(path), "sg-grasp")));
 }
 
 }  // namespace

@@ -10,24 +10,17 @@
 
 #include <random>
 
+#include "tests/support/manual_clock.hpp"
+
 namespace sg::auth {
 namespace {
 
 constexpr int kTrials = 10'000;
 constexpr int64_t kT0 = 1'780'000'000'000'000;  // µs since the epoch (2026)
 
-/// A clock that stands where the test puts it (utime() only; nothing here waits).
-class ManualClock final : public Clock {
- public:
-  int64_t at = kT0;
-  double now() override { return static_cast<double>(at) * 1e-6; }
-  int64_t utime() override { return at; }
-  bool wait_until(std::unique_lock<std::mutex>&, double, const std::function<bool()>& ready,
-                  std::stop_token) override {
-    return ready();
-  }
-  void notify() override {}
-  void sleep_until(double) override {}
+/// The test's clock, at kT0 unless moved.
+struct ManualClock : test::ManualClock {
+  ManualClock() : test::ManualClock(kT0) {}
 };
 
 LabKey key_of(uint8_t seed) {
